@@ -1,0 +1,192 @@
+//! Projection stages (Qiu 2013 §2.2–2.3, eqs. 5–7, 10, 12, 15): PPE assembly and solve,
+//! velocity correction, position update.
+
+use crate::error::Cause;
+use crate::ppe::PpeSolve;
+use crate::scene::{Divergence, PressureGradient};
+use crate::stage::{Stage, StepContext, par_rows_mut};
+use crate::state::{State, Vector};
+use nalgebra::SMatrix;
+use rayon::prelude::*;
+
+/// Assembles `A p = b` (NUMERICS.md): `A = −L` with the Shao–Lo Laplacian (Qiu eq. 12,
+/// constant ρ) `L(p)_a = Σ_b c_ab (p_b − p_a)`, `c_ab = −2 V_b (r_ab·∇_aW_ab) / (ρ (r² + η²))`,
+/// η² = 0.01 h², over the non-free-surface particles (p = 0 on the free surface), and
+/// `b = −div u* / Δt` with `div u*_a = Σ_b V_b (u*_b − u*_a)·∇_aW_ab` (Qiu eq. 10).
+#[derive(Debug, Default)]
+pub struct PpeAssemble {
+    /// Divergence operator of the source term.
+    pub divergence: Divergence,
+}
+
+impl<const D: usize> Stage<D> for PpeAssemble {
+    fn name(&self) -> &'static str {
+        "ppe_assemble"
+    }
+
+    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+        let n = s.particles.len();
+        let sys = &mut s.ppe;
+        sys.row_of.resize(n, u32::MAX);
+        sys.particle_of.clear();
+        for a in 0..n {
+            if s.free_surface[a] {
+                sys.row_of[a] = u32::MAX;
+            } else {
+                sys.row_of[a] = sys.particle_of.len() as u32;
+                sys.particle_of.push(a as u32);
+            }
+        }
+        let rows = sys.particle_of.len();
+        sys.singular = rows == n;
+        let (list, row_of, particle_of) = (&s.neighbours, &sys.row_of, &sys.particle_of);
+        // Row lengths: the diagonal plus the interior neighbours.
+        let m = &mut sys.matrix;
+        m.row_ptr.resize(rows + 1, 0);
+        m.row_ptr[0] = 0;
+        m.row_ptr[1..].par_iter_mut().enumerate().with_min_len(256).for_each(|(i, len)| {
+            let a = particle_of[i] as usize;
+            *len = 1 + list.of(a).iter().filter(|&&b| row_of[b as usize] != u32::MAX).count();
+        });
+        for i in 0..rows {
+            m.row_ptr[i + 1] += m.row_ptr[i];
+        }
+        m.entries.resize(m.row_ptr[rows], (0, 0.0));
+        m.inv_diag.resize(rows, 0.0);
+        let (v, rho, eta2) = (s.volume, s.density, 0.01 * s.h * s.h);
+        let pairs = &s.pairs;
+        par_rows_mut(&m.row_ptr, &mut m.entries, &|i, row: &mut [(u32, f64)]| {
+            let a = particle_of[i] as usize;
+            let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
+            let mut diag = 0.0;
+            let mut k = 1;
+            for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+                let c = -2.0 * v * p.f * p.r2 / (rho * (p.r2 + eta2));
+                diag += c;
+                let rb = row_of[b as usize];
+                if rb != u32::MAX {
+                    row[k] = (rb, -c);
+                    k += 1;
+                }
+            }
+            row[0] = (i as u32, diag);
+        });
+        let entries = &m.entries;
+        let row_ptr = &m.row_ptr;
+        m.inv_diag.par_iter_mut().enumerate().with_min_len(512).for_each(|(i, d)| {
+            *d = 1.0 / entries[row_ptr[i]].1;
+        });
+        sys.rhs.resize(rows, 0.0);
+        let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
+        sys.rhs.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
+            let a = particle_of[i] as usize;
+            let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
+            let div = if corrected {
+                let mut g = SMatrix::<f64, D, D>::zeros();
+                let mut m = SMatrix::<f64, D, D>::zeros();
+                for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+                    let grad = p.r_ab * p.f;
+                    g += (u[b as usize] - u[a]) * grad.transpose();
+                    m -= p.r_ab * grad.transpose();
+                }
+                match m.try_inverse() {
+                    Some(mi) => (g * mi).trace(),
+                    None => v * g.trace(),
+                }
+            } else {
+                let mut div = 0.0;
+                for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+                    div += (u[b as usize] - u[a]).dot(&p.r_ab) * p.f;
+                }
+                v * div
+            };
+            *r = -div * inv_dt;
+        });
+        Ok(())
+    }
+}
+
+/// Solves the assembled PPE (Qiu eq. 5) with the scene's solver, warm-started from the
+/// previous pressure; writes p (zero on the free surface).
+#[derive(Debug)]
+pub struct PpeSolveStage {
+    /// The configured solver.
+    pub solver: PpeSolve,
+}
+
+impl<const D: usize> Stage<D> for PpeSolveStage {
+    fn name(&self) -> &'static str {
+        "ppe_solve"
+    }
+
+    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+        let sys = &mut s.ppe;
+        let p = &mut s.particles.p;
+        sys.solution.resize(sys.particle_of.len(), 0.0);
+        for (x, &a) in sys.solution.iter_mut().zip(&sys.particle_of) {
+            *x = p[a as usize];
+        }
+        sys.info = self.solver.solve(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular)?;
+        p.iter_mut().for_each(|v| *v = 0.0);
+        for (x, &a) in sys.solution.iter().zip(&sys.particle_of) {
+            p[a as usize] = *x;
+        }
+        Ok(())
+    }
+}
+
+/// Velocity correction (Qiu eq. 6): `u^{n+1} = u* − Δt (∇p/ρ)` with the symmetric gradient
+/// of Qiu eq. 15, `Σ_b V_b (p_a + p_b) ∇_aW_ab / ρ`, or the difference form
+/// `Σ_b V_b (p_b − p_a) ∇_aW_ab / ρ`.
+#[derive(Debug)]
+pub struct Correction {
+    /// Gradient form.
+    pub form: PressureGradient,
+}
+
+impl<const D: usize> Stage<D> for Correction {
+    fn name(&self) -> &'static str {
+        "correction"
+    }
+
+    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+        let (list, pairs, p) = (&s.neighbours, &s.pairs, &s.particles.p);
+        let c = ctx.dt * s.volume / s.density;
+        let sign = match self.form {
+            PressureGradient::Symmetric => 1.0,
+            PressureGradient::Difference => -1.0,
+        };
+        s.particles.u.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
+            let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
+            let mut g = Vector::<D>::zeros();
+            for (pr, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+                g += pr.r_ab * (pr.f * (p[b as usize] + sign * p[a]));
+            }
+            *u -= g * c;
+        });
+        Ok(())
+    }
+}
+
+/// Position update (Qiu eq. 7): `r^{n+1} = r^n + Δt (u^{n+1} + u^n) / 2`.
+#[derive(Debug)]
+pub struct Position;
+
+impl<const D: usize> Stage<D> for Position {
+    fn name(&self) -> &'static str {
+        "position"
+    }
+
+    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+        let (dt, dom) = (ctx.dt, s.domain);
+        let periodic = dom.is_periodic();
+        let (x_old, u_old, u) = (&s.x_old, &s.u_old, &s.particles.u);
+        s.particles.x.par_iter_mut().enumerate().with_min_len(512).for_each(|(a, x)| {
+            *x = x_old[a] + (u[a] + u_old[a]) * (0.5 * dt);
+            if periodic {
+                dom.wrap(x);
+            }
+        });
+        Ok(())
+    }
+}

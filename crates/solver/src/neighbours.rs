@@ -1,0 +1,339 @@
+//! Neighbour search: cell lists (cell ≥ search radius), CSR neighbour lists, parallel.
+//!
+//! Every particle gets its own full list (pairs stored both ways), so parallel loops over
+//! particles write only their own particle: no atomics, and the result does not depend on
+//! the thread count. Cost is O(N): each particle scans the 3^D cells around its own.
+//! Periodic axes wrap the cell grid and use the minimum-image displacement ([`Domain`]).
+
+use nalgebra::SVector;
+use rayon::prelude::*;
+
+/// Periodicity of the domain: the minimum-image displacement on periodic axes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Domain<const D: usize> {
+    /// Per axis: `Some((min, max))` if periodic.
+    pub periodic: [Option<(f64, f64)>; D],
+}
+
+impl<const D: usize> Default for Domain<D> {
+    fn default() -> Self {
+        Self { periodic: [None; D] }
+    }
+}
+
+impl<const D: usize> Domain<D> {
+    /// True if any axis is periodic.
+    #[inline]
+    pub fn is_periodic(&self) -> bool {
+        self.periodic.iter().any(Option::is_some)
+    }
+
+    /// `r_a − r_b` with the minimum-image convention on periodic axes \[m\].
+    #[inline(always)]
+    pub fn displacement(&self, xa: &SVector<f64, D>, xb: &SVector<f64, D>) -> SVector<f64, D> {
+        let mut d = xa - xb;
+        for k in 0..D {
+            if let Some((lo, hi)) = self.periodic[k] {
+                let l = hi - lo;
+                d[k] -= l * (d[k] / l).round();
+            }
+        }
+        d
+    }
+
+    /// Wraps a position into the periodic range on periodic axes.
+    #[inline]
+    pub fn wrap(&self, x: &mut SVector<f64, D>) {
+        for k in 0..D {
+            if let Some((lo, hi)) = self.periodic[k] {
+                let l = hi - lo;
+                x[k] = lo + (x[k] - lo).rem_euclid(l);
+            }
+        }
+    }
+}
+
+/// Neighbour lists in compressed sparse row form: the neighbours of particle `a` are
+/// `indices[offsets[a]..offsets[a + 1]]` (self excluded), in a fixed order.
+#[derive(Debug, Clone, Default)]
+pub struct NeighbourList {
+    /// Row offsets, length N + 1.
+    pub offsets: Vec<usize>,
+    /// Column indices (neighbour particle indices).
+    pub indices: Vec<u32>,
+}
+
+impl NeighbourList {
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.offsets.len().saturating_sub(1)
+    }
+
+    /// True if there are no particles.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Neighbours of particle `a`.
+    #[inline(always)]
+    pub fn of(&self, a: usize) -> &[u32] {
+        &self.indices[self.offsets[a]..self.offsets[a + 1]]
+    }
+
+    /// Total number of (directed) pairs.
+    pub fn pairs(&self) -> usize {
+        self.indices.len()
+    }
+}
+
+/// Cell-list neighbour search with reusable scratch space (no allocation once warmed up).
+#[derive(Debug, Clone)]
+pub struct CellSearch<const D: usize> {
+    radius: f64,
+    domain: Domain<D>,
+    origin: SVector<f64, D>,
+    cell_size: SVector<f64, D>,
+    dims: [usize; D],
+    cell_of: Vec<u32>,
+    cell_start: Vec<u32>,
+    sorted: Vec<u32>,
+    chunk_rows: Vec<Vec<u32>>,
+    counts: Vec<u32>,
+}
+
+/// Rows per parallel task when filling the lists.
+const CHUNK: usize = 512;
+
+impl<const D: usize> CellSearch<D> {
+    /// A search for all pairs closer than `radius` \[m\] in `domain`.
+    pub fn new(radius: f64, domain: Domain<D>) -> Self {
+        Self {
+            radius,
+            domain,
+            origin: SVector::zeros(),
+            cell_size: SVector::repeat(radius),
+            dims: [1; D],
+            cell_of: Vec::new(),
+            cell_start: Vec::new(),
+            sorted: Vec::new(),
+            chunk_rows: Vec::new(),
+            counts: Vec::new(),
+        }
+    }
+
+    /// Search radius \[m\].
+    pub fn radius(&self) -> f64 {
+        self.radius
+    }
+
+    /// Bins the particles into cells (counting sort, stable).
+    fn bin(&mut self, x: &[SVector<f64, D>]) {
+        let n = x.len();
+        let mut lo = SVector::<f64, D>::repeat(f64::INFINITY);
+        let mut hi = SVector::<f64, D>::repeat(f64::NEG_INFINITY);
+        for p in x {
+            lo = lo.inf(p);
+            hi = hi.sup(p);
+        }
+        for k in 0..D {
+            if let Some((a, b)) = self.domain.periodic[k] {
+                // Whole number of cells per period, each at least the radius.
+                let cells = ((b - a) / self.radius).floor().max(1.0) as usize;
+                self.dims[k] = cells;
+                self.origin[k] = a;
+                self.cell_size[k] = (b - a) / cells as f64;
+            } else {
+                self.origin[k] = lo[k];
+                self.cell_size[k] = self.radius;
+                self.dims[k] = (((hi[k] - lo[k]) / self.radius).floor() as usize + 1).max(1);
+            }
+        }
+        let ncells: usize = self.dims.iter().product();
+        self.cell_of.resize(n, 0);
+        let (origin, size, dims) = (self.origin, self.cell_size, self.dims);
+        self.cell_of.par_iter_mut().zip(x.par_iter()).for_each(|(c, p)| {
+            let mut id = 0usize;
+            for k in (0..D).rev() {
+                let i = (((p[k] - origin[k]) / size[k]).floor().max(0.0) as usize).min(dims[k] - 1);
+                id = id * dims[k] + i;
+            }
+            *c = id as u32;
+        });
+        self.cell_start.clear();
+        self.cell_start.resize(ncells + 1, 0);
+        for &c in &self.cell_of {
+            self.cell_start[c as usize + 1] += 1;
+        }
+        for c in 0..ncells {
+            self.cell_start[c + 1] += self.cell_start[c];
+        }
+        self.sorted.resize(n, 0);
+        self.counts.clear();
+        self.counts.extend_from_slice(&self.cell_start[..ncells]);
+        for (i, &c) in self.cell_of.iter().enumerate() {
+            let slot = &mut self.counts[c as usize];
+            self.sorted[*slot as usize] = i as u32;
+            *slot += 1;
+        }
+    }
+
+    /// A permutation `perm` (new index → old index) that orders particles by cell, for
+    /// memory locality; apply it to every particle array.
+    pub fn cell_order(&mut self, x: &[SVector<f64, D>]) -> Vec<u32> {
+        self.bin(x);
+        self.sorted.clone()
+    }
+
+    /// Builds the neighbour lists of all particles at positions `x` into `list`.
+    pub fn build(&mut self, x: &[SVector<f64, D>], list: &mut NeighbourList) {
+        self.bin(x);
+        let n = x.len();
+        let nchunks = n.div_ceil(CHUNK);
+        if self.chunk_rows.len() < nchunks {
+            self.chunk_rows.resize_with(nchunks, Vec::new);
+        }
+        list.offsets.resize(n + 1, 0);
+        let r2 = self.radius * self.radius;
+        let mut chunk_rows = std::mem::take(&mut self.chunk_rows);
+        let this = &*self;
+        chunk_rows[..nchunks]
+            .par_iter_mut()
+            .zip(list.offsets[1..].par_chunks_mut(CHUNK))
+            .enumerate()
+            .for_each(|(c, (rows, counts))| {
+                rows.clear();
+                for (k, count) in counts.iter_mut().enumerate() {
+                    let a = c * CHUNK + k;
+                    let before = rows.len();
+                    this.visit_candidates(&x[a], |b| {
+                        if b as usize != a
+                            && this.domain.displacement(&x[a], &x[b as usize]).norm_squared() < r2
+                        {
+                            rows.push(b);
+                        }
+                    });
+                    *count = (rows.len() - before) as usize;
+                }
+            });
+        list.offsets[0] = 0;
+        for a in 0..n {
+            list.offsets[a + 1] += list.offsets[a];
+        }
+        list.indices.clear();
+        for rows in &chunk_rows[..nchunks] {
+            list.indices.extend_from_slice(rows);
+        }
+        self.chunk_rows = chunk_rows;
+    }
+
+    /// Calls `f` with every particle in the 3^D cells around `p` (each particle once).
+    #[inline]
+    fn visit_candidates(&self, p: &SVector<f64, D>, mut f: impl FnMut(u32)) {
+        let mut base = [0isize; D];
+        for k in 0..D {
+            base[k] = (((p[k] - self.origin[k]) / self.cell_size[k]).floor().max(0.0) as isize)
+                .min(self.dims[k] as isize - 1);
+        }
+        let mut off = [-1isize; D];
+        'cells: loop {
+            let mut id = 0usize;
+            let mut valid = true;
+            for k in (0..D).rev() {
+                let mut i = base[k] + off[k];
+                let dk = self.dims[k] as isize;
+                if self.domain.periodic[k].is_some() {
+                    // With fewer than 3 cells per period, offsets would revisit a cell.
+                    if dk < 3 && off[k] != 0 && (dk == 1 || off[k] == 1) {
+                        valid = false;
+                        break;
+                    }
+                    i = i.rem_euclid(dk);
+                } else if i < 0 || i >= dk {
+                    valid = false;
+                    break;
+                }
+                id = id * self.dims[k] + i as usize;
+            }
+            if valid {
+                let (s, e) = (self.cell_start[id] as usize, self.cell_start[id + 1] as usize);
+                for &j in &self.sorted[s..e] {
+                    f(j);
+                }
+            }
+            let mut k = 0;
+            loop {
+                if k == D {
+                    break 'cells;
+                }
+                off[k] += 1;
+                if off[k] <= 1 {
+                    break;
+                }
+                off[k] = -1;
+                k += 1;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{Rng, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    fn brute<const D: usize>(x: &[SVector<f64, D>], r: f64, dom: &Domain<D>) -> Vec<Vec<u32>> {
+        (0..x.len())
+            .map(|a| {
+                (0..x.len())
+                    .filter(|&b| b != a && dom.displacement(&x[a], &x[b]).norm() < r)
+                    .map(|b| b as u32)
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn check<const D: usize>(n: usize, r: f64, dom: Domain<D>, seed: u64) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let x: Vec<SVector<f64, D>> =
+            (0..n).map(|_| SVector::from_fn(|_, _| rng.random_range(0.0..1.0))).collect();
+        let mut search = CellSearch::new(r, dom);
+        let mut list = NeighbourList::default();
+        search.build(&x, &mut list);
+        let want = brute(&x, r, &dom);
+        for a in 0..n {
+            let mut got = list.of(a).to_vec();
+            got.sort_unstable();
+            assert_eq!(got, want[a], "particle {a}");
+        }
+    }
+
+    #[test]
+    fn matches_brute_force_2d_and_3d() {
+        for seed in 0..4 {
+            check::<2>(700, 0.07, Domain::default(), seed);
+            check::<3>(600, 0.15, Domain::default(), seed);
+        }
+    }
+
+    #[test]
+    fn matches_brute_force_with_periodic_axes() {
+        let per = Domain { periodic: [Some((0.0, 1.0)), None] };
+        check::<2>(800, 0.09, per, 7);
+        let per3 = Domain { periodic: [Some((0.0, 1.0)), None, Some((0.0, 1.0))] };
+        check::<3>(500, 0.2, per3, 8);
+        // Fewer than three cells per period.
+        check::<2>(200, 0.45, per, 9);
+    }
+
+    #[test]
+    fn cell_order_is_a_permutation() {
+        let mut rng = ChaCha8Rng::seed_from_u64(3);
+        let x: Vec<SVector<f64, 2>> =
+            (0..300).map(|_| SVector::from_fn(|_, _| rng.random_range(-1.0..1.0))).collect();
+        let mut s = CellSearch::new(0.1, Domain::default());
+        let mut p = s.cell_order(&x);
+        p.sort_unstable();
+        assert!(p.iter().enumerate().all(|(i, &v)| v as usize == i));
+    }
+}

@@ -1,0 +1,364 @@
+//! The pressure Poisson system `A p = b` and its solvers (faer).
+//!
+//! `A = −L` is the Shao–Lo Laplacian (Qiu 2013 eq. 12, NUMERICS.md "Signs and the PPE
+//! matrix") restricted to the particles that are not free-surface particles (their p = 0
+//! is a Dirichlet condition, so their columns drop out). Rows are assembled in parallel
+//! straight into compressed sparse rows from the neighbour lists, in the fixed neighbour
+//! order: the pattern is known, so the sort that a triplet assembly performs is not needed
+//! per step. [`PpeMatrix::to_triplets`] gives the triplet form for the direct solver and
+//! for tests that check the fast assembly against faer's triplet assembly.
+//!
+//! Krylov solvers are faer's (`matrix_free::conjugate_gradient`, `matrix_free::bicgstab`)
+//! with a Jacobi preconditioner; the direct solver is faer's sparse LU. The operator is
+//! applied row-parallel (each row written by one task), and faer's vector operations run
+//! with `Par::Seq`, so the result does not depend on the thread count.
+
+use crate::error::Cause;
+use crate::scene::{PpeOptions, PpeSolver};
+use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
+use faer::mat::{MatMut, MatRef};
+use faer::matrix_free::bicgstab::{BicgParams, bicgstab, bicgstab_scratch};
+use faer::matrix_free::conjugate_gradient::{CgParams, conjugate_gradient, conjugate_gradient_scratch};
+use faer::matrix_free::{InitialGuessStatus, LinOp, Precond};
+use faer::sparse::{SparseColMat, Triplet};
+use faer::{Mat, Par};
+use rayon::prelude::*;
+
+/// Sparse PPE matrix in compressed sparse rows, with its inverse diagonal (Jacobi).
+#[derive(Debug, Clone, Default)]
+pub struct PpeMatrix {
+    /// Row offsets (length n + 1).
+    pub row_ptr: Vec<usize>,
+    /// (column, value) entries of each row; values in units of `(1/ρ) ∇²` \[m/kg\].
+    pub entries: Vec<(u32, f64)>,
+    /// 1 / A_ii.
+    pub inv_diag: Vec<f64>,
+}
+
+impl PpeMatrix {
+    /// Number of unknowns.
+    pub fn n(&self) -> usize {
+        self.inv_diag.len()
+    }
+
+    /// y = A x (row-parallel, deterministic).
+    pub fn mul(&self, x: &[f64], y: &mut [f64]) {
+        y.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, yi)| {
+            let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
+            let mut acc = 0.0;
+            for &(c, v) in &self.entries[s..e] {
+                acc += v * x[c as usize];
+            }
+            *yi = acc;
+        });
+    }
+
+    /// The matrix as triplets (row, column, value).
+    pub fn to_triplets(&self) -> Vec<Triplet<usize, usize, f64>> {
+        let mut t = Vec::with_capacity(self.entries.len());
+        for i in 0..self.n() {
+            for &(c, v) in &self.entries[self.row_ptr[i]..self.row_ptr[i + 1]] {
+                t.push(Triplet::new(i, c as usize, v));
+            }
+        }
+        t
+    }
+}
+
+impl LinOp<f64> for PpeMatrix {
+    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
+        StackReq::EMPTY
+    }
+    fn nrows(&self) -> usize {
+        self.n()
+    }
+    fn ncols(&self) -> usize {
+        self.n()
+    }
+    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
+        for j in 0..rhs.ncols() {
+            let x = rhs.col(j).try_as_col_major().expect("faer columns are contiguous");
+            let y = out.as_mut().col_mut(j).try_as_col_major_mut().expect("faer columns are contiguous");
+            self.mul(x.as_slice(), y.as_slice_mut());
+        }
+    }
+    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
+        self.apply(out, rhs, par, stack);
+    }
+}
+
+/// Jacobi preconditioner `M⁻¹ = diag(A)⁻¹`.
+#[derive(Debug, Clone, Copy)]
+struct Jacobi<'a>(&'a [f64]);
+
+impl LinOp<f64> for Jacobi<'_> {
+    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
+        StackReq::EMPTY
+    }
+    fn nrows(&self) -> usize {
+        self.0.len()
+    }
+    fn ncols(&self) -> usize {
+        self.0.len()
+    }
+    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
+        for j in 0..rhs.ncols() {
+            for i in 0..self.0.len() {
+                out[(i, j)] = self.0[i] * rhs[(i, j)];
+            }
+        }
+    }
+    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
+        self.apply(out, rhs, par, stack);
+    }
+}
+
+impl Precond<f64> for Jacobi<'_> {}
+
+/// What a solve did.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct PpeInfo {
+    /// Krylov iterations (0 for the direct solver).
+    pub iterations: usize,
+    /// Final relative residual ‖b − A p‖ / ‖b‖.
+    pub residual: f64,
+}
+
+/// A PPE solver with reusable workspace.
+pub struct PpeSolve {
+    opts: PpeOptions,
+    x: Mat<f64>,
+    b: Mat<f64>,
+    buf: Option<(usize, MemBuffer)>,
+}
+
+impl std::fmt::Debug for PpeSolve {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("PpeSolve").field("opts", &self.opts).field("n", &self.x.nrows()).finish()
+    }
+}
+
+impl PpeSolve {
+    /// A solver configured by the scene's `scheme.isph.ppe` options.
+    pub fn new(opts: PpeOptions) -> Self {
+        Self { opts, x: Mat::zeros(0, 1), b: Mat::zeros(0, 1), buf: None }
+    }
+
+    /// Name of the configured solver.
+    pub fn name(&self) -> &'static str {
+        match self.opts.solver {
+            PpeSolver::Bicgstab => "bicgstab",
+            PpeSolver::Cg => "cg",
+            PpeSolver::Direct => "direct",
+        }
+    }
+
+    /// Solves `A p = b`; `p` holds the warm start on entry and the solution on exit.
+    ///
+    /// `singular` marks a system with no Dirichlet row (closed or periodic domain): `A`
+    /// then has the constant vector as null space, so `b` is projected onto mean zero and
+    /// the returned `p` has mean zero (NUMERICS.md).
+    pub fn solve(
+        &mut self,
+        a: &PpeMatrix,
+        b: &[f64],
+        p: &mut [f64],
+        singular: bool,
+    ) -> Result<PpeInfo, Cause> {
+        let n = a.n();
+        if n == 0 {
+            return Ok(PpeInfo::default());
+        }
+        if self.x.nrows() != n {
+            self.x = Mat::zeros(n, 1);
+            self.b = Mat::zeros(n, 1);
+        }
+        let mean_b = if singular { b.iter().sum::<f64>() / n as f64 } else { 0.0 };
+        for i in 0..n {
+            self.b[(i, 0)] = b[i] - mean_b;
+            self.x[(i, 0)] = p[i];
+        }
+        let bnorm = self.b.norm_l2();
+        if bnorm == 0.0 {
+            p.iter_mut().for_each(|v| *v = 0.0);
+            return Ok(PpeInfo::default());
+        }
+        let info = match self.opts.solver {
+            PpeSolver::Cg => self.krylov(a, true)?,
+            PpeSolver::Bicgstab => self.krylov(a, false)?,
+            PpeSolver::Direct => self.direct(a, singular)?,
+        };
+        let mean_x = if singular { (0..n).map(|i| self.x[(i, 0)]).sum::<f64>() / n as f64 } else { 0.0 };
+        for i in 0..n {
+            p[i] = self.x[(i, 0)] - mean_x;
+        }
+        // The residual as measured here, whatever the solver's internal norm.
+        let mut r = vec![0.0; n];
+        a.mul(p, &mut r);
+        let res = r.iter().zip(b).map(|(ri, bi)| (bi - mean_b - ri).powi(2)).sum::<f64>().sqrt() / bnorm;
+        Ok(PpeInfo { iterations: info.iterations, residual: res })
+    }
+
+    fn workspace(&mut self, req: StackReq) -> &mut MemStack {
+        let need = req.size_bytes();
+        if self.buf.as_ref().is_none_or(|(have, _)| *have < need) {
+            self.buf = Some((need, MemBuffer::new(req)));
+        }
+        MemStack::new(&mut self.buf.as_mut().expect("allocated above").1)
+    }
+
+    fn krylov(&mut self, a: &PpeMatrix, cg: bool) -> Result<PpeInfo, Cause> {
+        let m = Jacobi(&a.inv_diag);
+        let (tol, max_iters) = (self.opts.tolerance, self.opts.max_iterations);
+        let name = self.name();
+        let mut x = std::mem::replace(&mut self.x, Mat::zeros(0, 1));
+        let b = std::mem::replace(&mut self.b, Mat::zeros(0, 1));
+        let result = if cg {
+            let req = conjugate_gradient_scratch(m, a, 1, Par::Seq);
+            let stack = self.workspace(req);
+            let mut params = CgParams::<f64>::default();
+            params.initial_guess = InitialGuessStatus::MaybeNonZero;
+            params.rel_tolerance = tol;
+            params.abs_tolerance = 0.0;
+            params.max_iters = max_iters;
+            conjugate_gradient(x.as_mut(), m, a, b.as_ref(), params, |_| {}, Par::Seq, stack)
+                .map(|i| PpeInfo { iterations: i.iter_count, residual: i.rel_residual })
+                .map_err(|e| match e {
+                    faer::matrix_free::conjugate_gradient::CgError::NoConvergence {
+                        rel_residual, ..
+                    } => Cause::PpeNoConvergence {
+                        solver: name,
+                        residual: rel_residual,
+                        iterations: max_iters,
+                    },
+                    other => Cause::PpeBreakdown { solver: name, reason: format!("{other:?}") },
+                })
+        } else {
+            let req = bicgstab_scratch(m, faer::matrix_free::IdentityPrecond { dim: a.n() }, a, 1, Par::Seq);
+            let stack = self.workspace(req);
+            let mut params = BicgParams::<f64>::default();
+            params.initial_guess = InitialGuessStatus::MaybeNonZero;
+            params.rel_tolerance = tol;
+            params.abs_tolerance = 0.0;
+            params.max_iters = max_iters;
+            bicgstab(
+                x.as_mut(),
+                m,
+                faer::matrix_free::IdentityPrecond { dim: a.n() },
+                a,
+                b.as_ref(),
+                params,
+                |_| {},
+                Par::Seq,
+                stack,
+            )
+            .map(|i| PpeInfo { iterations: i.iter_count, residual: i.rel_residual })
+            .map_err(|e| match e {
+                faer::matrix_free::bicgstab::BicgError::NoConvergence { rel_residual, .. } => {
+                    Cause::PpeNoConvergence { solver: name, residual: rel_residual, iterations: max_iters }
+                }
+            })
+        };
+        self.x = x;
+        self.b = b;
+        result
+    }
+
+    fn direct(&mut self, a: &PpeMatrix, singular: bool) -> Result<PpeInfo, Cause> {
+        let n = a.n();
+        let mut trip = a.to_triplets();
+        if singular {
+            // Pin p_0 = 0 (the mean is fixed afterwards): replace row 0 by the identity.
+            trip.retain(|t| t.row != 0);
+            trip.push(Triplet::new(0, 0, 1.0));
+            self.b[(0, 0)] = 0.0;
+        }
+        let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip)
+            .map_err(|e| Cause::PpeBreakdown { solver: "direct", reason: format!("{e:?}") })?;
+        let lu = m.sp_lu().map_err(|e| Cause::PpeBreakdown { solver: "direct", reason: format!("{e:?}") })?;
+        use faer::linalg::solvers::SolveCore;
+        self.x.copy_from(&self.b);
+        lu.solve_in_place_with_conj(faer::Conj::No, self.x.as_mut());
+        Ok(PpeInfo { iterations: 0, residual: 0.0 })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// 5-point Laplacian on an m×m grid with Dirichlet boundary, as a PpeMatrix.
+    fn grid(m: usize) -> PpeMatrix {
+        let mut a = PpeMatrix { row_ptr: vec![0], ..Default::default() };
+        for i in 0..m {
+            for j in 0..m {
+                let k = i * m + j;
+                let mut push = |c: usize, v: f64| a.entries.push((c as u32, v));
+                if i > 0 {
+                    push(k - m, -1.0);
+                }
+                if j > 0 {
+                    push(k - 1, -1.0);
+                }
+                push(k, 4.0);
+                if j + 1 < m {
+                    push(k + 1, -1.0);
+                }
+                if i + 1 < m {
+                    push(k + m, -1.0);
+                }
+                a.row_ptr.push(a.entries.len());
+                a.inv_diag.push(0.25);
+            }
+        }
+        a
+    }
+
+    #[test]
+    fn all_solvers_agree_on_a_poisson_problem() {
+        let a = grid(20);
+        let n = a.n();
+        let x_true: Vec<f64> = (0..n).map(|i| ((i * 7919) % 97) as f64 / 97.0).collect();
+        let mut b = vec![0.0; n];
+        a.mul(&x_true, &mut b);
+        for solver in [PpeSolver::Cg, PpeSolver::Bicgstab, PpeSolver::Direct] {
+            let mut s = PpeSolve::new(PpeOptions { solver, tolerance: 1e-10, max_iterations: 1000 });
+            let mut p = vec![0.0; n];
+            let info = s.solve(&a, &b, &mut p, false).unwrap();
+            let err = p.iter().zip(&x_true).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            assert!(err < 1e-7, "{solver:?}: error {err}, {info:?}");
+            assert!(info.residual < 1e-9, "{solver:?}: {info:?}");
+        }
+    }
+
+    #[test]
+    fn non_convergence_is_a_typed_error() {
+        let a = grid(30);
+        let b = vec![1.0; a.n()];
+        let mut s = PpeSolve::new(PpeOptions { solver: PpeSolver::Cg, tolerance: 1e-12, max_iterations: 3 });
+        let mut p = vec![0.0; a.n()];
+        assert!(matches!(s.solve(&a, &b, &mut p, false), Err(Cause::PpeNoConvergence { .. })));
+    }
+
+    #[test]
+    fn singular_system_is_projected() {
+        // Periodic 1D Laplacian: rows sum to zero.
+        let n = 50;
+        let mut a = PpeMatrix { row_ptr: vec![0], ..Default::default() };
+        for i in 0..n {
+            for (c, v) in [((i + n - 1) % n, -1.0), (i, 2.0), ((i + 1) % n, -1.0)] {
+                a.entries.push((c as u32, v));
+            }
+            a.row_ptr.push(a.entries.len());
+            a.inv_diag.push(0.5);
+        }
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).sin() + 0.7).collect();
+        for solver in [PpeSolver::Cg, PpeSolver::Bicgstab, PpeSolver::Direct] {
+            let mut s = PpeSolve::new(PpeOptions { solver, tolerance: 1e-10, max_iterations: 2000 });
+            let mut p = vec![0.0; n];
+            let info = s.solve(&a, &b, &mut p, true).unwrap();
+            assert!(info.residual < 1e-8, "{solver:?} {info:?}");
+            assert!(p.iter().sum::<f64>().abs() < 1e-8);
+        }
+    }
+}

@@ -1,0 +1,170 @@
+//! Probes: time series of measured quantities (DESIGN.md "Run outputs", `probes.json`).
+//!
+//! Every probe kind writes one or more named quantities; the record is
+//! `{ "t": [...], "<probe kind>": { "<quantity>": [...] } }`, arrays aligned with `t`.
+
+use crate::scene::Probe;
+use crate::state::{State, Vector};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Recorded probe series.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct ProbeRecord {
+    /// Sample times \[s\].
+    pub t: Vec<f64>,
+    /// Probe kind → quantity → values aligned with `t`.
+    #[serde(flatten)]
+    pub series: BTreeMap<String, BTreeMap<String, Vec<f64>>>,
+}
+
+impl ProbeRecord {
+    /// The series `kind.quantity`, if recorded.
+    pub fn get(&self, kind: &str, quantity: &str) -> Option<&[f64]> {
+        self.series.get(kind)?.get(quantity).map(Vec::as_slice)
+    }
+
+    fn push(&mut self, kind: &str, quantity: &str, value: f64) {
+        self.series.entry(kind.to_string()).or_default().entry(quantity.to_string()).or_default().push(value);
+    }
+}
+
+/// Kernel weight W(r) used by the Shepard average of `pressure_at`, with its support.
+pub struct Weight {
+    /// W(r) \[1/m^D\].
+    pub w: Box<dyn Fn(f64) -> f64 + Send + Sync>,
+    /// Support radius \[m\].
+    pub support: f64,
+}
+
+impl std::fmt::Debug for Weight {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Weight {{ support: {} }}", self.support)
+    }
+}
+
+/// The scene's probes with their output keys (`pressure_at`, `pressure_at_1`, ...).
+#[derive(Debug)]
+pub struct ProbeSet {
+    probes: Vec<(String, Probe)>,
+    weight: Weight,
+}
+
+impl ProbeSet {
+    /// Probes of a scene; repeated kinds get `_1`, `_2`, ... suffixes.
+    pub fn new(probes: &[Probe], weight: Weight) -> Self {
+        let mut seen: BTreeMap<&'static str, usize> = BTreeMap::new();
+        let probes = probes
+            .iter()
+            .map(|p| {
+                let base = kind_name(p);
+                let k = seen.entry(base).or_insert(0);
+                let key = if *k == 0 { base.to_string() } else { format!("{base}_{k}") };
+                *k += 1;
+                (key, p.clone())
+            })
+            .collect();
+        Self { probes, weight }
+    }
+
+    /// Appends one sample of every probe at time `t`.
+    pub fn record<const D: usize>(&self, s: &State<D>, t: f64, out: &mut ProbeRecord) {
+        out.t.push(t);
+        let x = &s.particles.x;
+        let u = &s.particles.u;
+        let mass = s.density * s.volume;
+        for (key, probe) in &self.probes {
+            match probe {
+                Probe::EllipseAxes {} => {
+                    let n = x.len() as f64;
+                    let c: Vector<D> = x.iter().sum::<Vector<D>>() / n;
+                    let mut m2 = Vector::<D>::zeros();
+                    let mut lo = Vector::<D>::repeat(f64::INFINITY);
+                    let mut hi = Vector::<D>::repeat(f64::NEG_INFINITY);
+                    for p in x {
+                        let d = p - c;
+                        m2 += d.component_mul(&d);
+                        lo = lo.inf(p);
+                        hi = hi.sup(p);
+                    }
+                    m2 /= n;
+                    out.push(key, "a_moment", 2.0 * m2[0].sqrt());
+                    out.push(key, "b_moment", 2.0 * m2[1].sqrt());
+                    out.push(key, "a_extent", 0.5 * (hi[0] - lo[0]));
+                    out.push(key, "b_extent", 0.5 * (hi[1] - lo[1]));
+                    out.push(key, "x_centroid", c[0]);
+                    out.push(key, "y_centroid", c[1]);
+                }
+                Probe::PressureAt { point } => {
+                    let q = Vector::<D>::from_fn(|i, _| point[i]);
+                    let (mut num, mut den) = (0.0, 0.0);
+                    for (a, p) in x.iter().enumerate() {
+                        let r = s.domain.displacement(p, &q).norm();
+                        if r < self.weight.support {
+                            let w = (self.weight.w)(r);
+                            num += w * s.particles.p[a];
+                            den += w;
+                        }
+                    }
+                    out.push(key, "p", if den > 0.0 { num / den } else { f64::NAN });
+                }
+                Probe::KineticEnergy {} => {
+                    let e: f64 = u.iter().map(|v| 0.5 * mass * v.norm_squared()).sum();
+                    out.push(key, "e", e);
+                }
+                Probe::Momentum {} => {
+                    let p: Vector<D> = u.iter().sum::<Vector<D>>() * mass;
+                    for (i, name) in ["px", "py", "pz"].iter().enumerate().take(D) {
+                        out.push(key, name, p[i]);
+                    }
+                    let lz: f64 = x.iter().zip(u).map(|(r, v)| mass * (r[0] * v[1] - r[1] * v[0])).sum();
+                    out.push(key, "lz", lz);
+                }
+                Probe::Disorder {} => {
+                    let (min_pair, close) = disorder(s);
+                    out.push(key, "min_pair_over_dx", min_pair / s.dx);
+                    out.push(key, "close_fraction", close);
+                }
+                Probe::Solver {} => {
+                    out.push(key, "free_surface_count", s.free_surface.iter().filter(|&&f| f).count() as f64);
+                    out.push(key, "iterations", s.ppe.info.iterations as f64);
+                    out.push(key, "residual", s.ppe.info.residual);
+                }
+            }
+        }
+    }
+}
+
+/// Smallest neighbour distance \[m\] and the fraction of particles with a neighbour closer
+/// than 0.5 Δx, at the current positions over the current neighbour lists.
+fn disorder<const D: usize>(s: &State<D>) -> (f64, f64) {
+    let x = &s.particles.x;
+    if s.neighbours.len() != x.len() {
+        return (f64::NAN, f64::NAN);
+    }
+    let mut min = f64::INFINITY;
+    let mut close = 0usize;
+    for a in 0..x.len() {
+        let mut m = f64::INFINITY;
+        for &b in s.neighbours.of(a) {
+            m = m.min(s.domain.displacement(&x[a], &x[b as usize]).norm());
+        }
+        min = min.min(m);
+        if m < 0.5 * s.dx {
+            close += 1;
+        }
+    }
+    (min, close as f64 / x.len().max(1) as f64)
+}
+
+/// Output key of a probe kind.
+pub fn kind_name(p: &Probe) -> &'static str {
+    match p {
+        Probe::EllipseAxes {} => "ellipse_axes",
+        Probe::PressureAt { .. } => "pressure_at",
+        Probe::KineticEnergy {} => "kinetic_energy",
+        Probe::Momentum {} => "momentum",
+        Probe::Disorder {} => "disorder",
+        Probe::Solver {} => "solver",
+    }
+}

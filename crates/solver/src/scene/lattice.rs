@@ -1,0 +1,144 @@
+//! Particle generation: bodies filled on the cell-centred lattice (DESIGN.md "Meaning").
+//!
+//! Along each axis the lattice is `x = c + (i + ½) Δx` about the shape's centre `c`, so it
+//! is symmetric about the centre; a disc keeps the points with `|x − c| ≤ R`
+//! (R = 1, Δx = 0.04 gives the 1976 particles of Qiu 2013 §3.1).
+
+use super::schema::{Body, InitialPressure, InitialVelocity, Shape};
+use nalgebra::{SMatrix, SVector};
+
+/// Relative tolerance on shape membership, so lattice points exactly on the boundary count.
+const EDGE_TOL: f64 = 1e-9;
+
+/// Initial state of one particle.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Seed<const D: usize> {
+    /// Position \[m\].
+    pub x: SVector<f64, D>,
+    /// Velocity \[m/s\].
+    pub u: SVector<f64, D>,
+    /// Pressure \[Pa\].
+    pub p: f64,
+}
+
+/// Lattice points of `shape` at spacing `dx` (shape assumed validated for dimension `D`).
+pub fn lattice_points<const D: usize>(shape: &Shape, dx: f64) -> Vec<SVector<f64, D>> {
+    match shape {
+        Shape::Circle { center, radius } | Shape::Sphere { center, radius } => {
+            let c = SVector::<f64, D>::from_iterator(center.iter().copied());
+            let n = (radius / dx).ceil() as i64 + 1;
+            let r2 = radius * radius * (1.0 + EDGE_TOL);
+            let mut out = Vec::new();
+            for_each_index::<D>(-n - 1, n, |idx| {
+                let x = c + SVector::<f64, D>::from_fn(|k, _| (idx[k] as f64 + 0.5) * dx);
+                if (x - c).norm_squared() <= r2 {
+                    out.push(x);
+                }
+            });
+            out
+        }
+        Shape::Rectangle { min, max } | Shape::Box { min, max } => {
+            let lo = SVector::<f64, D>::from_iterator(min.iter().copied());
+            let hi = SVector::<f64, D>::from_iterator(max.iter().copied());
+            let c = (lo + hi) * 0.5;
+            let counts: [i64; D] = std::array::from_fn(|k| ((hi[k] - lo[k]) / dx + EDGE_TOL).floor() as i64);
+            let mut out = Vec::new();
+            for_each_index::<D>(0, counts.iter().copied().max().unwrap_or(0) - 1, |idx| {
+                if (0..D).all(|k| idx[k] < counts[k]) {
+                    out.push(SVector::<f64, D>::from_fn(|k, _| {
+                        c[k] + (idx[k] as f64 - 0.5 * (counts[k] - 1) as f64) * dx
+                    }));
+                }
+            });
+            out
+        }
+    }
+}
+
+/// Seeds (position, velocity, pressure) of one body; `g` is the body force for hydrostatic
+/// pressure, `density` the fluid density \[kg/m³\].
+pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector<f64, D>) -> Vec<Seed<D>> {
+    let velocity = |x: &SVector<f64, D>| match &body.velocity {
+        InitialVelocity::Zero => SVector::<f64, D>::zeros(),
+        InitialVelocity::Affine { gradient, offset } => {
+            let m = SMatrix::<f64, D, D>::from_fn(|i, j| gradient[i][j]);
+            m * x + SVector::<f64, D>::from_iterator(offset.iter().copied())
+        }
+    };
+    let pressure = |x: &SVector<f64, D>| match &body.pressure {
+        InitialPressure::Zero => 0.0,
+        InitialPressure::Quadratic { center, value, hessian } => {
+            let c = SVector::<f64, D>::from_iterator(center.iter().copied());
+            let h = SMatrix::<f64, D, D>::from_fn(|i, j| hessian[i][j]);
+            let r = x - c;
+            value + 0.5 * r.dot(&(h * r))
+        }
+        InitialPressure::Hydrostatic { surface_point } => {
+            let s = SVector::<f64, D>::from_iterator(surface_point.iter().copied());
+            density * g.dot(&(x - s))
+        }
+    };
+    lattice_points::<D>(&body.shape, dx)
+        .into_iter()
+        .map(|x| Seed { x, u: velocity(&x), p: pressure(&x) })
+        .collect()
+}
+
+/// Calls `f` for every integer index in `[lo, hi]^D`, last axis fastest.
+fn for_each_index<const D: usize>(lo: i64, hi: i64, mut f: impl FnMut(&[i64; D])) {
+    if hi < lo {
+        return;
+    }
+    let mut idx = [lo; D];
+    loop {
+        f(&idx);
+        let mut k = D;
+        loop {
+            if k == 0 {
+                return;
+            }
+            k -= 1;
+            if idx[k] < hi {
+                idx[k] += 1;
+                break;
+            }
+            idx[k] = lo;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn disc(r: f64) -> Shape {
+        Shape::Circle { center: vec![0.0, 0.0], radius: r }
+    }
+
+    #[test]
+    fn qiu_particle_counts() {
+        // CASES.md: 1976, 7860, 31428, 125676 particles.
+        for (dx, n) in [(0.04, 1976), (0.02, 7860), (0.01, 31428), (0.005, 125676)] {
+            assert_eq!(lattice_points::<2>(&disc(1.0), dx).len(), n, "dx = {dx}");
+        }
+    }
+
+    #[test]
+    fn rectangle_is_cell_centred_and_symmetric() {
+        let s = Shape::Rectangle { min: vec![-0.5, -0.5], max: vec![0.5, 0.5] };
+        let pts = lattice_points::<2>(&s, 0.02);
+        assert_eq!(pts.len(), 2500);
+        let c: SVector<f64, 2> = pts.iter().sum::<SVector<f64, 2>>() / pts.len() as f64;
+        assert!(c.norm() < 1e-12);
+        let xmin = pts.iter().map(|p| p.x).fold(f64::INFINITY, f64::min);
+        assert!((xmin + 0.49).abs() < 1e-12);
+    }
+
+    #[test]
+    fn sphere_in_3d() {
+        let s = Shape::Sphere { center: vec![0.0; 3], radius: 0.2 };
+        let pts = lattice_points::<3>(&s, 0.05);
+        assert!(pts.iter().all(|p| p.norm() <= 0.2 + 1e-12));
+        assert!(!pts.is_empty());
+    }
+}

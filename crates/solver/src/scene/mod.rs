@@ -1,0 +1,41 @@
+//! Scene files: schema ([`schema`]), value checks ([`validate()`]) and particle
+//! generation on the cell-centred lattice ([`lattice`]).
+
+pub mod lattice;
+pub mod schema;
+mod validate;
+
+pub use schema::*;
+pub use validate::validate;
+
+use crate::error::SceneError;
+use std::path::Path;
+
+impl Scene {
+    /// Parses a scene from JSON text and checks every value.
+    ///
+    /// Errors name the field path (`fluid.density`), the value and the rule; unknown
+    /// fields and wrong types are errors too.
+    pub fn from_json(text: &str) -> Result<Scene, SceneError> {
+        let de = &mut serde_json::Deserializer::from_str(text);
+        let scene: Scene = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let field = if path.is_empty() || path == "." { "scene".to_string() } else { path };
+            SceneError::parse(field, e.into_inner().to_string())
+        })?;
+        validate(&scene)?;
+        Ok(scene)
+    }
+
+    /// Reads and parses a scene file (see [`Scene::from_json`]).
+    pub fn from_path(path: &Path) -> Result<Scene, SceneError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| SceneError::Io { path: path.display().to_string(), reason: e.to_string() })?;
+        Scene::from_json(&text)
+    }
+
+    /// Smoothing length h = h_over_dx · dx \[m\].
+    pub fn h(&self) -> f64 {
+        self.kernel.h_over_dx * self.dx
+    }
+}

@@ -1,0 +1,365 @@
+//! The scene file schema (DESIGN.md "Scene files"): plain serde types, SI units.
+//!
+//! Field names are a contract: scripts and `validation/` cases depend on them. Unknown
+//! fields are rejected everywhere (`deny_unknown_fields`); values are checked by
+//! [`super::validate`].
+
+use serde::{Deserialize, Serialize};
+
+/// One run: geometry, fluid, scheme, time and what to measure.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Name of the scene, used in outputs.
+    pub name: String,
+    /// Spatial dimension: 2 (3 is parsed and checked; the runner supports 2 and 3).
+    pub dimension: usize,
+    /// Initial particle spacing Δx \[m\].
+    pub dx: f64,
+    /// Smoothing kernel and smoothing length.
+    pub kernel: KernelSpec,
+    /// Fluid properties.
+    pub fluid: Fluid,
+    /// Body force per unit mass g \[m/s²\] (one component per dimension); zero if absent.
+    #[serde(default)]
+    pub body_force: Vec<f64>,
+    /// Bodies filled with particles on the cell-centred lattice.
+    pub bodies: Vec<Body>,
+    /// Boundary conditions other than free surfaces (walls, periodic axes, inflow/outflow).
+    #[serde(default)]
+    pub boundaries: Boundaries,
+    /// The scheme and its options.
+    pub scheme: Scheme,
+    /// End time and time-step rule.
+    pub time: TimeSpec,
+    /// Quantities recorded as time series.
+    #[serde(default)]
+    pub probes: Vec<Probe>,
+    /// How often probes and frames are written.
+    #[serde(default)]
+    pub output: OutputSpec,
+}
+
+/// Kernel choice: `W(r, h)` with `h = h_over_dx · dx`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct KernelSpec {
+    /// Kernel family.
+    pub kind: KernelKind,
+    /// Smoothing length over particle spacing, h / Δx (Qiu 2013 uses 1.5).
+    pub h_over_dx: f64,
+}
+
+/// Kernel families (see [`crate::kernel`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum KernelKind {
+    /// Cubic B-spline, Monaghan & Lattanzio 1985 (Qiu 2013 eq. 8), support 2h.
+    CubicSpline,
+    /// Wendland C2 (Wendland 1995), support 2h.
+    WendlandC2,
+}
+
+/// Fluid properties (constant density: the projection scheme keeps ρ fixed).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Fluid {
+    /// Density ρ \[kg/m³\].
+    pub density: f64,
+    /// Dynamic viscosity μ \[Pa·s\].
+    pub viscosity: f64,
+    /// Surface tension coefficient σ \[N/m\]; 0 (default) builds no surface-tension stage.
+    #[serde(default)]
+    pub surface_tension: f64,
+}
+
+/// A region filled with particles.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Body {
+    /// Fluid or wall particles.
+    pub role: Role,
+    /// The region.
+    pub shape: Shape,
+    /// Initial velocity field (zero if absent).
+    #[serde(default)]
+    pub velocity: InitialVelocity,
+    /// Initial pressure field (zero if absent).
+    #[serde(default)]
+    pub pressure: InitialPressure,
+}
+
+/// What the particles of a body are.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Role {
+    /// Moving fluid particles.
+    Fluid,
+    /// Fixed wall particles.
+    Wall,
+}
+
+/// Shapes; all lengths in metres.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Shape {
+    /// Disc (2D): `|x - center| <= radius`.
+    Circle {
+        /// Centre \[m\].
+        center: Vec<f64>,
+        /// Radius \[m\].
+        radius: f64,
+    },
+    /// Axis-aligned rectangle (2D) `min <= x <= max`.
+    Rectangle {
+        /// Lower corner \[m\].
+        min: Vec<f64>,
+        /// Upper corner \[m\].
+        max: Vec<f64>,
+    },
+    /// Axis-aligned box (3D) `min <= x <= max`.
+    Box {
+        /// Lower corner \[m\].
+        min: Vec<f64>,
+        /// Upper corner \[m\].
+        max: Vec<f64>,
+    },
+    /// Ball (3D): `|x - center| <= radius`.
+    Sphere {
+        /// Centre \[m\].
+        center: Vec<f64>,
+        /// Radius \[m\].
+        radius: f64,
+    },
+}
+
+/// Initial velocity field.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum InitialVelocity {
+    /// u = 0.
+    #[default]
+    Zero,
+    /// `u(x) = gradient · x + offset`; row i of `gradient` gives component i \[1/s\], offset \[m/s\].
+    Affine {
+        /// Velocity gradient ∂u_i/∂x_j, row i = component i \[1/s\].
+        gradient: Vec<Vec<f64>>,
+        /// Constant part \[m/s\].
+        offset: Vec<f64>,
+    },
+}
+
+/// Initial pressure field.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum InitialPressure {
+    /// p = 0.
+    #[default]
+    Zero,
+    /// `p(x) = value + ½ (x − c)ᵀ hessian (x − c)` \[Pa\].
+    Quadratic {
+        /// Centre c \[m\].
+        center: Vec<f64>,
+        /// Value at the centre \[Pa\].
+        value: f64,
+        /// Hessian \[Pa/m²\] (symmetric).
+        hessian: Vec<Vec<f64>>,
+    },
+    /// `p = ρ g · (x − surface_point)` with the scene's body force g: zero at `surface_point`.
+    Hydrostatic {
+        /// A point on the free surface \[m\].
+        surface_point: Vec<f64>,
+    },
+}
+
+/// Boundary conditions beyond free surfaces. Empty (the default) builds no boundary stage.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Boundaries {
+    /// Periodic axes (0 = x, 1 = y, 2 = z) with their period.
+    #[serde(default)]
+    pub periodic: Vec<PeriodicAxis>,
+}
+
+/// One periodic axis: positions wrap into `[min, max)`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PeriodicAxis {
+    /// Axis index (0 = x).
+    pub axis: usize,
+    /// Lower end of the period \[m\].
+    pub min: f64,
+    /// Upper end of the period \[m\].
+    pub max: f64,
+}
+
+/// Particle scheme.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Scheme {
+    /// Projection ISPH (Qiu 2013 §2.2–2.6; Cummins & Rudman 1999; Shao & Lo 2003).
+    Isph(IsphOptions),
+}
+
+/// Options of the projection ISPH scheme.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IsphOptions {
+    /// Pressure Poisson solver.
+    pub ppe: PpeOptions,
+    /// Free-surface threshold on `div r` (Qiu eq. 16 corrected; 1.5 in 2D).
+    pub free_surface_threshold: f64,
+    /// Particle shifting (none if absent).
+    #[serde(default)]
+    pub shifting: Shifting,
+    /// Form of the pressure gradient in the correction step.
+    #[serde(default)]
+    pub pressure_gradient: PressureGradient,
+    /// Form of the velocity divergence on the PPE right-hand side.
+    #[serde(default)]
+    pub divergence: Divergence,
+}
+
+/// Velocity-divergence operator of the PPE source term.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Divergence {
+    /// Qiu 2013 eq. 10: `Σ_b V_b (u_b − u_a)·∇_aW_ab`.
+    #[default]
+    Standard,
+    /// Kernel-gradient corrected (Bonet & Lok 1999): `tr(G_a M_a⁻¹)` with
+    /// `G_a = Σ_b V_b (u_b − u_a) ⊗ ∇_aW_ab`, `M_a = Σ_b V_b (r_b − r_a) ⊗ ∇_aW_ab`;
+    /// exact for linear velocity fields on any particle arrangement.
+    Corrected,
+}
+
+/// Pressure Poisson solver options (DESIGN.md "The solver").
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PpeOptions {
+    /// Linear solver.
+    pub solver: PpeSolver,
+    /// Relative residual tolerance ‖b − Ax‖/‖b‖ (Qiu 2013 uses 1e-3).
+    pub tolerance: f64,
+    /// Iteration cap of the Krylov solvers.
+    pub max_iterations: usize,
+}
+
+/// Linear solvers for the PPE.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PpeSolver {
+    /// BiCGSTAB with a Jacobi preconditioner (Qiu 2013).
+    Bicgstab,
+    /// Conjugate gradient with a Jacobi preconditioner (the matrix is SPD for equal volumes).
+    Cg,
+    /// Sparse LU factorisation (faer).
+    Direct,
+}
+
+/// Particle shifting (Qiu 2013 §2.6).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Shifting {
+    /// No shifting.
+    #[default]
+    None,
+    /// Xu et al. 2009 (Qiu eqs. 20–21): `δr = C Δt u_max Σ (r̄²/r²) n_ab`.
+    Xu {
+        /// C, 0.01–0.1 (Qiu uses 0.02).
+        coefficient: f64,
+    },
+    /// Lind et al. 2012 Fickian shifting: `δr = −A h |u| Δt ∇C`.
+    Fickian {
+        /// A, 1–6 (Lind uses 2).
+        coefficient: f64,
+    },
+}
+
+/// Pressure-gradient operator of the correction step.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum PressureGradient {
+    /// Qiu 2013 eq. 15: `Σ V_b (p_a + p_b) ∇W / ρ` (momentum conserving).
+    #[default]
+    Symmetric,
+    /// `Σ V_b (p_b − p_a) ∇W / ρ` (zero-order consistent).
+    Difference,
+}
+
+/// End time and time-step rule.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TimeSpec {
+    /// End time \[s\].
+    pub end: f64,
+    /// Step rule.
+    pub step: TimeStep,
+}
+
+/// Time-step rule.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum TimeStep {
+    /// Fixed Δt \[s\].
+    Fixed(f64),
+    /// Adaptive (Qiu eqs. 17–19): `Δt = min(α_c h/u_max, α_d ρ h²/μ)`, capped at `max`.
+    Adaptive {
+        /// α_c (Qiu: 0.2).
+        #[serde(default = "default_alpha")]
+        cfl: f64,
+        /// α_d (Qiu: 0.2).
+        #[serde(default = "default_alpha")]
+        viscous: f64,
+        /// Upper bound on Δt \[s\] (used while the fluid is at rest).
+        max: f64,
+    },
+}
+
+fn default_alpha() -> f64 {
+    0.2
+}
+
+/// A probe: a quantity recorded every `output.probe_every` steps.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Probe {
+    /// Ellipse semi-axes of the fluid: `a_moment`, `b_moment` (2 √⟨x²⟩ about the centroid),
+    /// `a_extent`, `b_extent` (half the extent of the particles), `x_centroid`, `y_centroid`.
+    EllipseAxes {},
+    /// Pressure at a point by a Shepard average over the kernel support: `p` \[Pa\].
+    PressureAt {
+        /// The point \[m\].
+        point: Vec<f64>,
+    },
+    /// Total kinetic energy per unit depth `e` \[J/m in 2D\].
+    KineticEnergy {},
+    /// Linear momentum components `px`, `py`(, `pz`) and angular momentum `lz` about the origin.
+    Momentum {},
+    /// Particle disorder: `min_pair_over_dx`, `close_fraction` (neighbour closer than 0.5 Δx).
+    Disorder {},
+    /// Free-surface particle count `count`, PPE iterations `iterations` and residual `residual`.
+    Solver {},
+}
+
+/// Output cadence.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OutputSpec {
+    /// Record probes every this many steps (and at t = 0 and the last step).
+    #[serde(default = "default_probe_every")]
+    pub probe_every: usize,
+    /// Write a VTK frame every this many steps (0 = none; `meniscus run --vtk` sets it).
+    #[serde(default)]
+    pub vtk_every: usize,
+}
+
+impl Default for OutputSpec {
+    fn default() -> Self {
+        Self { probe_every: default_probe_every(), vtk_every: 0 }
+    }
+}
+
+fn default_probe_every() -> usize {
+    10
+}

@@ -1,0 +1,241 @@
+//! Value checks of a parsed scene: every rule names the field, the value and the rule.
+
+use super::schema::*;
+use crate::error::SceneError;
+
+/// Checks every value of `scene`; the first violation is returned.
+pub fn validate(scene: &Scene) -> Result<(), SceneError> {
+    let d = scene.dimension;
+    if d != 2 && d != 3 {
+        return Err(SceneError::new("dimension", d, "must be 2 or 3"));
+    }
+    if scene.name.trim().is_empty() {
+        return Err(SceneError::new("name", "\"\"", "must not be empty"));
+    }
+    positive("dx", scene.dx)?;
+    positive("kernel.h_over_dx", scene.kernel.h_over_dx)?;
+    if scene.kernel.h_over_dx > 4.0 {
+        return Err(SceneError::new(
+            "kernel.h_over_dx",
+            scene.kernel.h_over_dx,
+            "must be at most 4 (wider kernels are not supported)",
+        ));
+    }
+    positive("fluid.density", scene.fluid.density)?;
+    non_negative("fluid.viscosity", scene.fluid.viscosity)?;
+    non_negative("fluid.surface_tension", scene.fluid.surface_tension)?;
+    if !scene.body_force.is_empty() {
+        vector("body_force", &scene.body_force, d)?;
+    }
+    if scene.bodies.is_empty() {
+        return Err(SceneError::new("bodies", "[]", "must contain at least one body"));
+    }
+    for (i, body) in scene.bodies.iter().enumerate() {
+        validate_body(&format!("bodies[{i}]"), body, d, scene.dx)?;
+    }
+    for (i, axis) in scene.boundaries.periodic.iter().enumerate() {
+        let f = format!("boundaries.periodic[{i}]");
+        if axis.axis >= d {
+            return Err(SceneError::new(
+                format!("{f}.axis"),
+                axis.axis,
+                "must be an axis of the scene (0..dimension)",
+            ));
+        }
+        finite(&format!("{f}.min"), axis.min)?;
+        finite(&format!("{f}.max"), axis.max)?;
+        if axis.max <= axis.min {
+            return Err(SceneError::new(format!("{f}.max"), axis.max, "must exceed min"));
+        }
+    }
+    match &scene.scheme {
+        Scheme::Isph(o) => validate_isph(o, d)?,
+    }
+    positive("time.end", scene.time.end)?;
+    match scene.time.step {
+        TimeStep::Fixed(dt) => {
+            positive("time.step.fixed", dt)?;
+            if dt > scene.time.end {
+                return Err(SceneError::new("time.step.fixed", dt, "must not exceed time.end"));
+            }
+        }
+        TimeStep::Adaptive { cfl, viscous, max } => {
+            positive("time.step.adaptive.cfl", cfl)?;
+            positive("time.step.adaptive.viscous", viscous)?;
+            positive("time.step.adaptive.max", max)?;
+            if cfl > 1.0 {
+                return Err(SceneError::new("time.step.adaptive.cfl", cfl, "must be at most 1"));
+            }
+        }
+    }
+    for (i, probe) in scene.probes.iter().enumerate() {
+        if let Probe::PressureAt { point } = probe {
+            vector(&format!("probes[{i}].pressure_at.point"), point, d)?;
+        }
+        if let Probe::EllipseAxes {} = probe
+            && d != 2
+        {
+            return Err(SceneError::new(
+                format!("probes[{i}].ellipse_axes"),
+                "{}",
+                "is defined for 2D scenes only",
+            ));
+        }
+    }
+    if scene.output.probe_every == 0 {
+        return Err(SceneError::new("output.probe_every", 0, "must be at least 1"));
+    }
+    Ok(())
+}
+
+fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
+    positive("scheme.isph.ppe.tolerance", o.ppe.tolerance)?;
+    if o.ppe.tolerance >= 1.0 {
+        return Err(SceneError::new(
+            "scheme.isph.ppe.tolerance",
+            o.ppe.tolerance,
+            "must be below 1 (a relative residual)",
+        ));
+    }
+    if o.ppe.max_iterations == 0 {
+        return Err(SceneError::new("scheme.isph.ppe.max_iterations", 0, "must be at least 1"));
+    }
+    let t = o.free_surface_threshold;
+    positive("scheme.isph.free_surface_threshold", t)?;
+    if t >= d as f64 {
+        return Err(SceneError::new(
+            "scheme.isph.free_surface_threshold",
+            t,
+            "must be below the dimension (div r is about D in the bulk)",
+        ));
+    }
+    match o.shifting {
+        Shifting::None => {}
+        Shifting::Xu { coefficient } => {
+            positive("scheme.isph.shifting.xu.coefficient", coefficient)?;
+            if coefficient > 1.0 {
+                return Err(SceneError::new(
+                    "scheme.isph.shifting.xu.coefficient",
+                    coefficient,
+                    "must be at most 1 (Xu 2009 uses 0.01–0.1)",
+                ));
+            }
+        }
+        Shifting::Fickian { coefficient } => {
+            positive("scheme.isph.shifting.fickian.coefficient", coefficient)?;
+            if coefficient > 10.0 {
+                return Err(SceneError::new(
+                    "scheme.isph.shifting.fickian.coefficient",
+                    coefficient,
+                    "must be at most 10 (Lind 2012 uses 1–6)",
+                ));
+            }
+        }
+    }
+    Ok(())
+}
+
+fn validate_body(f: &str, body: &Body, d: usize, dx: f64) -> Result<(), SceneError> {
+    match &body.shape {
+        Shape::Circle { center, radius } | Shape::Sphere { center, radius } => {
+            let kind = if matches!(body.shape, Shape::Circle { .. }) { "circle" } else { "sphere" };
+            let want = if kind == "circle" { 2 } else { 3 };
+            if d != want {
+                return Err(SceneError::new(
+                    format!("{f}.shape.{kind}"),
+                    kind,
+                    format!("is a {want}D shape but the scene is {d}D"),
+                ));
+            }
+            vector(&format!("{f}.shape.{kind}.center"), center, d)?;
+            positive(&format!("{f}.shape.{kind}.radius"), *radius)?;
+            if *radius < 0.5 * dx {
+                return Err(SceneError::new(
+                    format!("{f}.shape.{kind}.radius"),
+                    radius,
+                    "holds no particle (must be at least dx/2)",
+                ));
+            }
+        }
+        Shape::Rectangle { min, max } | Shape::Box { min, max } => {
+            let kind = if matches!(body.shape, Shape::Rectangle { .. }) { "rectangle" } else { "box" };
+            let want = if kind == "rectangle" { 2 } else { 3 };
+            if d != want {
+                return Err(SceneError::new(
+                    format!("{f}.shape.{kind}"),
+                    kind,
+                    format!("is a {want}D shape but the scene is {d}D"),
+                ));
+            }
+            vector(&format!("{f}.shape.{kind}.min"), min, d)?;
+            vector(&format!("{f}.shape.{kind}.max"), max, d)?;
+            for k in 0..d {
+                if max[k] - min[k] < dx * (1.0 - 1e-9) {
+                    return Err(SceneError::new(
+                        format!("{f}.shape.{kind}.max[{k}]"),
+                        max[k],
+                        "holds no particle (max − min must be at least dx)",
+                    ));
+                }
+            }
+        }
+    }
+    if let InitialVelocity::Affine { gradient, offset } = &body.velocity {
+        matrix(&format!("{f}.velocity.affine.gradient"), gradient, d)?;
+        vector(&format!("{f}.velocity.affine.offset"), offset, d)?;
+    }
+    match &body.pressure {
+        InitialPressure::Zero => {}
+        InitialPressure::Quadratic { center, value, hessian } => {
+            vector(&format!("{f}.pressure.quadratic.center"), center, d)?;
+            finite(&format!("{f}.pressure.quadratic.value"), *value)?;
+            matrix(&format!("{f}.pressure.quadratic.hessian"), hessian, d)?;
+        }
+        InitialPressure::Hydrostatic { surface_point } => {
+            vector(&format!("{f}.pressure.hydrostatic.surface_point"), surface_point, d)?;
+        }
+    }
+    Ok(())
+}
+
+fn finite(field: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() { Ok(()) } else { Err(SceneError::new(field, v, "must be finite")) }
+}
+
+fn positive(field: &str, v: f64) -> Result<(), SceneError> {
+    finite(field, v)?;
+    if v > 0.0 { Ok(()) } else { Err(SceneError::new(field, v, "must be positive")) }
+}
+
+fn non_negative(field: &str, v: f64) -> Result<(), SceneError> {
+    finite(field, v)?;
+    if v >= 0.0 { Ok(()) } else { Err(SceneError::new(field, v, "must not be negative")) }
+}
+
+fn vector(field: &str, v: &[f64], d: usize) -> Result<(), SceneError> {
+    if v.len() != d {
+        return Err(SceneError::new(
+            field,
+            format!("{v:?}"),
+            format!("must have {d} components (the scene's dimension)"),
+        ));
+    }
+    for (k, x) in v.iter().enumerate() {
+        finite(&format!("{field}[{k}]"), *x)?;
+    }
+    Ok(())
+}
+
+fn matrix(field: &str, m: &[Vec<f64>], d: usize) -> Result<(), SceneError> {
+    if m.len() != d {
+        return Err(SceneError::new(
+            field,
+            format!("{m:?}"),
+            format!("must have {d} rows (the scene's dimension)"),
+        ));
+    }
+    for (i, row) in m.iter().enumerate() {
+        vector(&format!("{field}[{i}]"), row, d)?;
+    }
+    Ok(())
+}

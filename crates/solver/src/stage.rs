@@ -1,0 +1,51 @@
+//! The step as a list of stages built once from the scene (DESIGN.md "composed from the
+//! scene"): dynamic dispatch between stages, static (monomorphised) inside them.
+
+use crate::error::Cause;
+use crate::state::State;
+
+/// Time-step data passed to every stage.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StepContext {
+    /// Step number being taken (1-based).
+    pub step: usize,
+    /// Time at the start of the step \[s\].
+    pub time: f64,
+    /// Step size Δt \[s\].
+    pub dt: f64,
+}
+
+/// One stage of a step.
+pub trait Stage<const D: usize>: Send + std::fmt::Debug {
+    /// Name used in `summary.json` stage timings and in error messages.
+    fn name(&self) -> &'static str;
+    /// Advances `state` by this stage.
+    fn run(&mut self, state: &mut State<D>, ctx: &StepContext) -> Result<(), Cause>;
+}
+
+/// Calls `f(a, row)` for every particle `a` with `row = data[offsets[a]..offsets[a + 1]]`,
+/// in parallel by recursive halving (no allocation; each row is written by one task).
+pub fn par_rows_mut<T: Send, F: Fn(usize, &mut [T]) + Sync>(offsets: &[usize], data: &mut [T], f: &F) {
+    fn rec<T: Send, F: Fn(usize, &mut [T]) + Sync>(
+        lo: usize,
+        hi: usize,
+        offsets: &[usize],
+        data: &mut [T],
+        f: &F,
+    ) {
+        if hi - lo <= 256 {
+            let base = offsets[lo];
+            for a in lo..hi {
+                f(a, &mut data[offsets[a] - base..offsets[a + 1] - base]);
+            }
+        } else {
+            let mid = lo + (hi - lo) / 2;
+            let (l, r) = data.split_at_mut(offsets[mid] - offsets[lo]);
+            rayon::join(|| rec(lo, mid, offsets, l, f), || rec(mid, hi, offsets, r, f));
+        }
+    }
+    let n = offsets.len().saturating_sub(1);
+    if n > 0 {
+        rec(0, n, offsets, data, f);
+    }
+}

@@ -1,0 +1,126 @@
+//! Particle storage (structure of arrays) and the per-step shared data (pair cache).
+
+use crate::neighbours::{Domain, NeighbourList};
+use nalgebra::SVector;
+
+/// Vector type of the solver.
+pub type Vector<const D: usize> = SVector<f64, D>;
+
+/// Fluid particles, structure of arrays. Arrays are reordered by cell for locality;
+/// `id` keeps each particle's index in the initial order.
+#[derive(Debug, Clone, Default)]
+pub struct Particles<const D: usize> {
+    /// Initial index of each particle.
+    pub id: Vec<u32>,
+    /// Positions \[m\].
+    pub x: Vec<Vector<D>>,
+    /// Velocities \[m/s\].
+    pub u: Vec<Vector<D>>,
+    /// Pressures \[Pa\].
+    pub p: Vec<f64>,
+}
+
+impl<const D: usize> Particles<D> {
+    /// Number of particles.
+    pub fn len(&self) -> usize {
+        self.x.len()
+    }
+
+    /// True if there are none.
+    pub fn is_empty(&self) -> bool {
+        self.x.is_empty()
+    }
+}
+
+/// Geometry of one neighbour pair (a, b) at the current positions, computed once per step
+/// and shared by the stages, so that `∇_a W_ab = f · r_ab`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pair<const D: usize> {
+    /// r_a − r_b (minimum image on periodic axes) \[m\].
+    pub r_ab: Vector<D>,
+    /// |r_ab|² \[m²\].
+    pub r2: f64,
+    /// f = W'(r)/r \[1/m^(D+2)\] (≤ 0; zero beyond the support).
+    pub f: f64,
+}
+
+impl<const D: usize> Default for Pair<D> {
+    fn default() -> Self {
+        Self { r_ab: Vector::zeros(), r2: 0.0, f: 0.0 }
+    }
+}
+
+/// Everything a step reads and writes.
+#[derive(Debug, Clone)]
+pub struct State<const D: usize> {
+    /// The particles.
+    pub particles: Particles<D>,
+    /// Positions at the start of the step (r^n) \[m\].
+    pub x_old: Vec<Vector<D>>,
+    /// Velocities at the start of the step (u^n) \[m/s\].
+    pub u_old: Vec<Vector<D>>,
+    /// Neighbour lists at the positions of the pair cache.
+    pub neighbours: NeighbourList,
+    /// Pair geometry, aligned with `neighbours.indices`.
+    pub pairs: Vec<Pair<D>>,
+    /// `div r` (Qiu eq. 16 corrected).
+    pub div_r: Vec<f64>,
+    /// Free-surface flags (`div r` below the threshold): p = 0 there.
+    pub free_surface: Vec<bool>,
+    /// Particle volume V = Δx^D \[m^D\] (equal for all particles).
+    pub volume: f64,
+    /// Density ρ \[kg/m³\].
+    pub density: f64,
+    /// Initial spacing Δx \[m\].
+    pub dx: f64,
+    /// Smoothing length h \[m\].
+    pub h: f64,
+    /// Periodicity.
+    pub domain: Domain<D>,
+    /// The assembled pressure Poisson system of the current step.
+    pub ppe: PpeSystem,
+}
+
+/// The PPE of the current step: matrix, right-hand side and the particle ↔ row maps.
+#[derive(Debug, Clone, Default)]
+pub struct PpeSystem {
+    /// Matrix over the rows of non-free-surface particles.
+    pub matrix: crate::ppe::PpeMatrix,
+    /// Right-hand side `−div u* / Δt` \[Pa/m² per kg/m³\].
+    pub rhs: Vec<f64>,
+    /// Row of each particle (`u32::MAX` for free-surface particles).
+    pub row_of: Vec<u32>,
+    /// Particle of each row.
+    pub particle_of: Vec<u32>,
+    /// Unknowns (pressures of the rows) \[Pa\].
+    pub solution: Vec<f64>,
+    /// True when no row is Dirichlet-constrained (closed or periodic domain).
+    pub singular: bool,
+    /// Iterations and residual of the last solve.
+    pub info: crate::ppe::PpeInfo,
+}
+
+impl<const D: usize> State<D> {
+    /// Largest particle speed \[m/s\] (order-independent reduction).
+    pub fn max_speed(&self) -> f64 {
+        self.particles.u.iter().map(|u| u.norm_squared()).fold(0.0, f64::max).sqrt()
+    }
+
+    /// Applies the permutation `perm` (new → old) to every particle array.
+    pub fn permute(&mut self, perm: &[u32]) {
+        fn apply<T: Copy>(v: &mut Vec<T>, perm: &[u32]) {
+            if v.len() == perm.len() {
+                let new: Vec<T> = perm.iter().map(|&i| v[i as usize]).collect();
+                *v = new;
+            }
+        }
+        apply(&mut self.particles.id, perm);
+        apply(&mut self.particles.x, perm);
+        apply(&mut self.particles.u, perm);
+        apply(&mut self.particles.p, perm);
+        apply(&mut self.x_old, perm);
+        apply(&mut self.u_old, perm);
+        apply(&mut self.free_surface, perm);
+        apply(&mut self.div_r, perm);
+    }
+}

@@ -1,0 +1,14 @@
+//! Shared helpers of the integration tests.
+#![allow(dead_code)]
+
+use meniscus::Scene;
+
+/// The DESIGN.md elliptical-drop scene (the contract's fixed point).
+pub const DROP: &str = include_str!("../../../validation/scenes/elliptical_drop.json");
+
+/// The drop scene with `edit` applied to its JSON value.
+pub fn drop_scene(edit: impl FnOnce(&mut serde_json::Value)) -> Scene {
+    let mut v: serde_json::Value = serde_json::from_str(DROP).expect("scene JSON");
+    edit(&mut v);
+    Scene::from_json(&v.to_string()).expect("valid scene")
+}

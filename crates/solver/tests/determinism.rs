@@ -1,0 +1,27 @@
+//! Results do not depend on the thread count (NUMERICS.md "Determinism").
+
+mod common;
+
+use serde_json::json;
+
+fn run_with(threads: usize) -> meniscus::RunReport {
+    let scene = common::drop_scene(|v| {
+        v["dx"] = json!(0.05);
+        v["time"]["end"] = json!(1e-3);
+        v["probes"] = json!([{"ellipse_axes": {}}, {"pressure_at": {"point": [0.0, 0.0]}},
+                             {"kinetic_energy": {}}, {"momentum": {}}, {"disorder": {}}, {"solver": {}}]);
+    });
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
+    pool.install(|| meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds"))
+}
+
+#[test]
+fn one_and_two_threads_give_identical_probes() {
+    let a = run_with(1);
+    let b = run_with(2);
+    assert!(a.error.is_none() && b.error.is_none());
+    assert_eq!(a.summary.threads, 1);
+    assert_eq!(b.summary.threads, 2);
+    assert_eq!(a.probes, b.probes, "probe series differ between 1 and 2 threads");
+    assert_eq!(a.final_frame, b.final_frame);
+}
