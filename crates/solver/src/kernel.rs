@@ -207,7 +207,7 @@ mod tests {
     }
     for_kernels_and_dims!(gradient_is_consistent, derivative_matches_finite_difference);
 
-    /// Σ_b V_b (x_b − x_a) ⊗ ∇_a W_ab = −I on a full lattice (first-moment consistency).
+    /// Σ_b V_b (x_b − x_a) ⊗ ∇_a W_ab = I on a full lattice (first-moment consistency).
     fn lattice_moment<K: Kernel, const D: usize>() {
         let dx = 0.1;
         let k = Scaled::<K, D>::new(1.5 * dx);
@@ -226,7 +226,7 @@ mod tests {
                 idx[d] = -n;
                 d += 1;
                 if d == D {
-                    let err = (m + nalgebra::SMatrix::<f64, D, D>::identity()).norm();
+                    let err = (m - nalgebra::SMatrix::<f64, D, D>::identity()).norm();
                     assert!(err < 0.03, "{} D={D}: moment error {err}", K::NAME);
                     return;
                 }

@@ -212,7 +212,7 @@ impl<const D: usize> CellSearch<D> {
                             rows.push(b);
                         }
                     });
-                    *count = (rows.len() - before) as usize;
+                    *count = rows.len() - before;
                 }
             });
         list.offsets[0] = 0;
@@ -301,10 +301,10 @@ mod tests {
         let mut list = NeighbourList::default();
         search.build(&x, &mut list);
         let want = brute(&x, r, &dom);
-        for a in 0..n {
+        for (a, want) in want.iter().enumerate() {
             let mut got = list.of(a).to_vec();
             got.sort_unstable();
-            assert_eq!(got, want[a], "particle {a}");
+            assert_eq!(&got, want, "particle {a}");
         }
     }
 

@@ -103,8 +103,10 @@ impl LinOp<f64> for Jacobi<'_> {
     }
     fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
         for j in 0..rhs.ncols() {
-            for i in 0..self.0.len() {
-                out[(i, j)] = self.0[i] * rhs[(i, j)];
+            let x = rhs.col(j).try_as_col_major().expect("faer columns are contiguous");
+            let y = out.as_mut().col_mut(j).try_as_col_major_mut().expect("faer columns are contiguous");
+            for ((yi, xi), di) in y.as_slice_mut().iter_mut().zip(x.as_slice()).zip(self.0) {
+                *yi = di * xi;
             }
         }
     }
@@ -129,6 +131,7 @@ pub struct PpeSolve {
     opts: PpeOptions,
     x: Mat<f64>,
     b: Mat<f64>,
+    r: Vec<f64>,
     buf: Option<(usize, MemBuffer)>,
 }
 
@@ -141,7 +144,7 @@ impl std::fmt::Debug for PpeSolve {
 impl PpeSolve {
     /// A solver configured by the scene's `scheme.isph.ppe` options.
     pub fn new(opts: PpeOptions) -> Self {
-        Self { opts, x: Mat::zeros(0, 1), b: Mat::zeros(0, 1), buf: None }
+        Self { opts, x: Mat::zeros(0, 1), b: Mat::zeros(0, 1), r: Vec::new(), buf: None }
     }
 
     /// Name of the configured solver.
@@ -189,13 +192,13 @@ impl PpeSolve {
             PpeSolver::Direct => self.direct(a, singular)?,
         };
         let mean_x = if singular { (0..n).map(|i| self.x[(i, 0)]).sum::<f64>() / n as f64 } else { 0.0 };
-        for i in 0..n {
-            p[i] = self.x[(i, 0)] - mean_x;
+        for (i, pi) in p.iter_mut().enumerate() {
+            *pi = self.x[(i, 0)] - mean_x;
         }
         // The residual as measured here, whatever the solver's internal norm.
-        let mut r = vec![0.0; n];
-        a.mul(p, &mut r);
-        let res = r.iter().zip(b).map(|(ri, bi)| (bi - mean_b - ri).powi(2)).sum::<f64>().sqrt() / bnorm;
+        self.r.resize(n, 0.0);
+        a.mul(p, &mut self.r);
+        let res = self.r.iter().zip(b).map(|(ri, bi)| (bi - mean_b - ri).powi(2)).sum::<f64>().sqrt() / bnorm;
         Ok(PpeInfo { iterations: info.iterations, residual: res })
     }
 
@@ -216,11 +219,13 @@ impl PpeSolve {
         let result = if cg {
             let req = conjugate_gradient_scratch(m, a, 1, Par::Seq);
             let stack = self.workspace(req);
-            let mut params = CgParams::<f64>::default();
-            params.initial_guess = InitialGuessStatus::MaybeNonZero;
-            params.rel_tolerance = tol;
-            params.abs_tolerance = 0.0;
-            params.max_iters = max_iters;
+            let params = CgParams::<f64> {
+                initial_guess: InitialGuessStatus::MaybeNonZero,
+                rel_tolerance: tol,
+                abs_tolerance: 0.0,
+                max_iters,
+                ..Default::default()
+            };
             conjugate_gradient(x.as_mut(), m, a, b.as_ref(), params, |_| {}, Par::Seq, stack)
                 .map(|i| PpeInfo { iterations: i.iter_count, residual: i.rel_residual })
                 .map_err(|e| match e {
@@ -236,11 +241,13 @@ impl PpeSolve {
         } else {
             let req = bicgstab_scratch(m, faer::matrix_free::IdentityPrecond { dim: a.n() }, a, 1, Par::Seq);
             let stack = self.workspace(req);
-            let mut params = BicgParams::<f64>::default();
-            params.initial_guess = InitialGuessStatus::MaybeNonZero;
-            params.rel_tolerance = tol;
-            params.abs_tolerance = 0.0;
-            params.max_iters = max_iters;
+            let params = BicgParams::<f64> {
+                initial_guess: InitialGuessStatus::MaybeNonZero,
+                rel_tolerance: tol,
+                abs_tolerance: 0.0,
+                max_iters,
+                ..Default::default()
+            };
             bicgstab(
                 x.as_mut(),
                 m,
@@ -328,6 +335,20 @@ mod tests {
             let err = p.iter().zip(&x_true).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
             assert!(err < 1e-7, "{solver:?}: error {err}, {info:?}");
             assert!(info.residual < 1e-9, "{solver:?}: {info:?}");
+        }
+    }
+
+    #[test]
+    fn triplet_form_is_the_same_matrix() {
+        let a = grid(7);
+        let m = SparseColMat::<usize, f64>::try_new_from_triplets(a.n(), a.n(), &a.to_triplets()).unwrap();
+        let x: Vec<f64> = (0..a.n()).map(|i| (i as f64).sin()).collect();
+        let mut y = vec![0.0; a.n()];
+        a.mul(&x, &mut y);
+        let xm = faer::Mat::<f64>::from_fn(a.n(), 1, |i, _| x[i]);
+        let ym = &m * &xm;
+        for i in 0..a.n() {
+            assert!((ym[(i, 0)] - y[i]).abs() < 1e-12);
         }
     }
 

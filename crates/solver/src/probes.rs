@@ -3,6 +3,7 @@
 //! Every probe kind writes one or more named quantities; the record is
 //! `{ "t": [...], "<probe kind>": { "<quantity>": [...] } }`, arrays aligned with `t`.
 
+use crate::neighbours::{CellSearch, Domain, NeighbourList};
 use crate::scene::Probe;
 use crate::state::{State, Vector};
 use serde::{Deserialize, Serialize};
@@ -45,16 +46,18 @@ impl std::fmt::Debug for Weight {
 
 /// The scene's probes with their output keys (`pressure_at`, `pressure_at_1`, ...).
 #[derive(Debug)]
-pub struct ProbeSet {
+pub struct ProbeSet<const D: usize> {
     probes: Vec<(String, Probe)>,
     weight: Weight,
+    /// Own neighbour search of the disorder probe (pairs closer than Δx).
+    search: Option<(CellSearch<D>, NeighbourList)>,
 }
 
-impl ProbeSet {
+impl<const D: usize> ProbeSet<D> {
     /// Probes of a scene; repeated kinds get `_1`, `_2`, ... suffixes.
-    pub fn new(probes: &[Probe], weight: Weight) -> Self {
+    pub fn new(probes: &[Probe], weight: Weight, dx: f64, domain: Domain<D>) -> Self {
         let mut seen: BTreeMap<&'static str, usize> = BTreeMap::new();
-        let probes = probes
+        let probes: Vec<(String, Probe)> = probes
             .iter()
             .map(|p| {
                 let base = kind_name(p);
@@ -64,11 +67,15 @@ impl ProbeSet {
                 (key, p.clone())
             })
             .collect();
-        Self { probes, weight }
+        let search = probes
+            .iter()
+            .any(|(_, p)| matches!(p, Probe::Disorder {}))
+            .then(|| (CellSearch::new(dx, domain), NeighbourList::default()));
+        Self { probes, weight, search }
     }
 
     /// Appends one sample of every probe at time `t`.
-    pub fn record<const D: usize>(&self, s: &State<D>, t: f64, out: &mut ProbeRecord) {
+    pub fn record(&mut self, s: &State<D>, t: f64, out: &mut ProbeRecord) {
         out.t.push(t);
         let x = &s.particles.x;
         let u = &s.particles.u;
@@ -121,7 +128,9 @@ impl ProbeSet {
                     out.push(key, "lz", lz);
                 }
                 Probe::Disorder {} => {
-                    let (min_pair, close) = disorder(s);
+                    let (search, list) = self.search.as_mut().expect("built for a disorder probe");
+                    search.build(x, list);
+                    let (min_pair, close) = disorder(s, list);
                     out.push(key, "min_pair_over_dx", min_pair / s.dx);
                     out.push(key, "close_fraction", close);
                 }
@@ -135,18 +144,15 @@ impl ProbeSet {
     }
 }
 
-/// Smallest neighbour distance \[m\] and the fraction of particles with a neighbour closer
-/// than 0.5 Δx, at the current positions over the current neighbour lists.
-fn disorder<const D: usize>(s: &State<D>) -> (f64, f64) {
+/// Smallest pair distance \[m\] (Δx when no pair is closer) and the fraction of particles
+/// with a neighbour closer than 0.5 Δx; `list` holds the pairs closer than Δx.
+fn disorder<const D: usize>(s: &State<D>, list: &NeighbourList) -> (f64, f64) {
     let x = &s.particles.x;
-    if s.neighbours.len() != x.len() {
-        return (f64::NAN, f64::NAN);
-    }
-    let mut min = f64::INFINITY;
+    let mut min = s.dx;
     let mut close = 0usize;
     for a in 0..x.len() {
-        let mut m = f64::INFINITY;
-        for &b in s.neighbours.of(a) {
+        let mut m = s.dx;
+        for &b in list.of(a) {
             m = m.min(s.domain.displacement(&x[a], &x[b as usize]).norm());
         }
         min = min.min(m);

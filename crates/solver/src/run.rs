@@ -99,7 +99,7 @@ pub struct Simulation<const D: usize> {
     scene: Scene,
     state: State<D>,
     stages: Vec<Box<dyn Stage<D>>>,
-    probes: ProbeSet,
+    probes: ProbeSet<D>,
     bounds: (Vector<D>, Vector<D>),
 }
 
@@ -208,7 +208,13 @@ impl<const D: usize> Simulation<D> {
             KernelKind::CubicSpline => build::<CubicSpline, D>(scene, h, domain),
             KernelKind::WendlandC2 => build::<WendlandC2, D>(scene, h, domain),
         };
-        Ok(Self { scene: scene.clone(), state, stages, probes: ProbeSet::new(&scene.probes, weight), bounds })
+        Ok(Self {
+            scene: scene.clone(),
+            state,
+            stages,
+            probes: ProbeSet::new(&scene.probes, weight, scene.dx, domain),
+            bounds,
+        })
     }
 
     /// The current state.

@@ -30,7 +30,7 @@ impl<K: Kernel, const D: usize> Stage<D> for Neighbours<K, D> {
     }
 
     fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
-        if self.reorder_every > 0 && self.calls % self.reorder_every == 0 {
+        if self.reorder_every > 0 && self.calls.is_multiple_of(self.reorder_every) {
             let perm = self.search.cell_order(&s.particles.x);
             s.permute(&perm);
         }

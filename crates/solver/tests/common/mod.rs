@@ -4,7 +4,7 @@
 use meniscus::Scene;
 
 /// The DESIGN.md elliptical-drop scene (the contract's fixed point).
-pub const DROP: &str = include_str!("../../../validation/scenes/elliptical_drop.json");
+pub const DROP: &str = include_str!("../../../../validation/scenes/elliptical_drop.json");
 
 /// The drop scene with `edit` applied to its JSON value.
 pub fn drop_scene(edit: impl FnOnce(&mut serde_json::Value)) -> Scene {

@@ -1,0 +1,42 @@
+//! Runs that go wrong stop with a diagnosis, keep their probes, and never panic.
+
+mod common;
+
+use meniscus::Cause;
+use serde_json::json;
+
+#[test]
+fn a_time_step_far_beyond_the_cfl_limit_diverges_with_a_named_cause() {
+    let scene = common::drop_scene(|v| {
+        v["dx"] = json!(0.04);
+        v["time"] = json!({"end": 0.008, "step": {"fixed": 2e-3}});
+        v["output"]["probe_every"] = json!(1);
+    });
+    let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
+    let err = report.error.as_ref().expect("the run must diverge");
+    assert_eq!(report.summary.status, "diverged");
+    assert!(report.summary.error.as_deref().is_some_and(|m| m.contains("step")));
+    assert!(err.step >= 1 && err.time < 0.008);
+    assert!(
+        matches!(err.cause, Cause::Escape { .. } | Cause::NonFinite { .. } | Cause::PpeNoConvergence { .. }),
+        "{err}"
+    );
+    // The probes recorded before the divergence are kept, one sample per finished step.
+    assert_eq!(report.probes.t.len(), report.summary.steps + 1);
+    assert!(report.probes.get("kinetic_energy", "e").is_some_and(|e| e.iter().all(|v| v.is_finite())));
+}
+
+#[test]
+fn adaptive_time_step_respects_qiu_limits_and_reaches_the_end() {
+    let scene = common::drop_scene(|v| {
+        v["dx"] = json!(0.04);
+        v["time"] = json!({"end": 0.008, "step": {"adaptive": {"max": 1e-4}}});
+    });
+    let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
+    assert!(report.error.is_none(), "{:?}", report.error);
+    assert!((report.summary.t_end - 0.008).abs() < 1e-12);
+    // dt <= 0.2 h / u_max with u_max >= 100 m/s gives at least 0.008 / 1.2e-4 steps.
+    assert!(report.summary.steps >= 67, "{} steps", report.summary.steps);
+    let b = report.probes.get("ellipse_axes", "b_moment").expect("probe");
+    assert!((b[b.len() - 1] - 1.9993).abs() < 0.04, "b = {}", b[b.len() - 1]);
+}
