@@ -45,12 +45,16 @@ pub fn build_stages<K: Kernel, const D: usize>(
     stages.push(Box::new(projection::Position));
     match opts.shifting {
         ShiftSpec::None => {}
-        ShiftSpec::Xu { coefficient } => {
-            stages.push(Box::new(shifting::Shifting::new(shifting::Law::Xu(coefficient), kernel)))
-        }
-        ShiftSpec::Fickian { coefficient } => {
-            stages.push(Box::new(shifting::Shifting::new(shifting::Law::Fickian(coefficient), kernel)))
-        }
+        ShiftSpec::Xu { coefficient } => stages.push(Box::new(shifting::Shifting::new(
+            shifting::Law::Xu(coefficient),
+            kernel,
+            opts.free_surface_threshold,
+        ))),
+        ShiftSpec::Fickian { coefficient } => stages.push(Box::new(shifting::Shifting::new(
+            shifting::Law::Fickian(coefficient),
+            kernel,
+            opts.free_surface_threshold,
+        ))),
     }
     stages
 }

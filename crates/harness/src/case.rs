@@ -1,0 +1,304 @@
+//! Case files `validation/<case>.json`: everything about a validation case is data.
+//!
+//! ```json
+//! { "case": "elliptical_drop", "title": "...", "description": "...", "scheme": "isph",
+//!   "scene": { ...a full scene, DESIGN.md "Scene files"... },
+//!   "sweep": { "dx": { "quick": [0.04, 0.02], "default": [0.04, 0.02], "full": [0.04, 0.02, 0.01, 0.005] },
+//!              "presets": [ { "name": "paper", "patch": {} },
+//!                           { "name": "tuned", "patch": { "scheme": { "isph": { "pressure_gradient": "difference" } } } } ] },
+//!   "reference": { "elliptical_drop": { "radius": 1.0, "a0": 100.0, "density": 1000.0 } },
+//!   "metrics": ["b_rel_err_max", ...], "key_metrics": ["b_rel_err_max"], "convergence": ["b_rel_err_max"],
+//!   "checks": [ { "name": "...", "metric": "b_rel_err_max", "select": { "dx": 0.02, "preset": "paper" }, "max": 0.01 } ],
+//!   "figures": [ { "history": { "file": "history_b", "series": ["b_moment"], "reference": "b_ref" } } ],
+//!   "errata": ["CASES.md erratum 1 ..."] }
+//! ```
+//! A preset is a JSON merge patch (RFC 7396, [`crate::patch`]) applied to the template;
+//! the first preset is the case's primary one (its orders go into `convergence`).
+
+use crate::checks::CheckSpec;
+use crate::error::{HarnessError, Result};
+use crate::io;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+/// A sweep tier (CASES.md): `quick` is CI, `default` the papers' spacings, `full` the
+/// extended sweep.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Tier {
+    /// CI tier (`--quick`).
+    Quick,
+    /// The papers' spacings (no flag).
+    Default,
+    /// Finer spacings and long runs (`--full`).
+    Full,
+}
+
+impl Tier {
+    /// The tier's name as written in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            Tier::Quick => "quick",
+            Tier::Default => "default",
+            Tier::Full => "full",
+        }
+    }
+}
+
+impl std::fmt::Display for Tier {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A validation case, as read from `validation/<case>.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Case {
+    /// Case name (the file stem, the report directory).
+    pub case: String,
+    /// One-line title for the report.
+    #[serde(default)]
+    pub title: String,
+    /// What the case tests.
+    #[serde(default)]
+    pub description: String,
+    /// Default scheme of the case (results.json top-level `scheme`).
+    pub scheme: String,
+    /// The scene template: a complete scene (its `dx` is replaced per run).
+    pub scene: serde_json::Value,
+    /// Which runs make up the sweep.
+    pub sweep: Sweep,
+    /// The analytical reference the metrics compare against.
+    pub reference: ReferenceSpec,
+    /// Metrics shown in the error table, in order (computed per reference kind).
+    #[serde(default)]
+    pub metrics: Vec<String>,
+    /// The few metrics shown on the index page.
+    #[serde(default)]
+    pub key_metrics: Vec<String>,
+    /// Metrics whose observed order in dx is fitted (least squares in log-log).
+    #[serde(default)]
+    pub convergence: Vec<String>,
+    /// Acceptance checks.
+    #[serde(default)]
+    pub checks: Vec<CheckSpec>,
+    /// Figures of the case page.
+    #[serde(default)]
+    pub figures: Vec<Figure>,
+    /// Errata of the source papers applied in this case (shown in the report).
+    #[serde(default)]
+    pub errata: Vec<String>,
+}
+
+/// Spacings per tier and the presets run at each spacing.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sweep {
+    /// Particle spacings per tier \[m\].
+    pub dx: BTreeMap<Tier, Vec<f64>>,
+    /// Option sets; every preset runs at every spacing of the tier (unless it names tiers).
+    pub presets: Vec<Preset>,
+}
+
+/// A named option set: a JSON merge patch on the scene template.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Preset {
+    /// Preset name (`paper`, `tuned`, ...): part of the run slug.
+    pub name: String,
+    /// What the preset changes and why.
+    #[serde(default)]
+    pub description: String,
+    /// RFC 7396 merge patch applied to the template.
+    #[serde(default = "empty_object")]
+    pub patch: serde_json::Value,
+    /// Tiers in which this preset runs (all when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tiers: Option<Vec<Tier>>,
+}
+
+fn empty_object() -> serde_json::Value {
+    serde_json::Value::Object(serde_json::Map::new())
+}
+
+/// The analytical reference of a case; metric computation is per kind ([`crate::metrics`]).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum ReferenceSpec {
+    /// The inviscid elliptical drop ODE (`meniscus_reference::elliptical_drop`).
+    EllipticalDrop {
+        /// Initial radius R \[m\].
+        radius: f64,
+        /// Initial strain rate A0 \[1/s\].
+        a0: f64,
+        /// Density \[kg/m^3\].
+        density: f64,
+    },
+}
+
+/// A figure of the case page (drawn from results.json only).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case", deny_unknown_fields)]
+pub enum Figure {
+    /// Time histories of run series against a reference series: one figure per preset,
+    /// one colour per resolution, one dash style per series.
+    History {
+        /// File stem (`<file>_<preset>.svg`).
+        file: String,
+        /// Title.
+        #[serde(default)]
+        title: String,
+        /// y-axis label.
+        #[serde(default)]
+        y_label: String,
+        /// Run series to draw (names in `runs[].series`).
+        series: Vec<String>,
+        /// Reference series (drawn once, from the finest run, in black).
+        #[serde(default)]
+        reference: Option<String>,
+    },
+    /// Error against dx in log-log, one line per metric and preset, with the fitted order
+    /// and a reference slope.
+    Convergence {
+        /// File stem.
+        file: String,
+        /// Title.
+        #[serde(default)]
+        title: String,
+        /// Metrics to draw.
+        metrics: Vec<String>,
+        /// Slope of the reference line (e.g. 2 for second order).
+        #[serde(default)]
+        slope: Option<f64>,
+    },
+    /// Run time against a metric, one point per run.
+    Cost {
+        /// File stem.
+        file: String,
+        /// Title.
+        #[serde(default)]
+        title: String,
+        /// The error metric on the x axis.
+        metric: String,
+    },
+}
+
+impl Case {
+    /// Parses a case from JSON text and checks its consistency; `origin` names the source
+    /// in errors.
+    pub fn from_json(text: &str, origin: &Path) -> Result<Case> {
+        let case: Case = serde_json::from_str(text)
+            .map_err(|source| HarnessError::Json { path: origin.to_path_buf(), source })?;
+        case.check()?;
+        Ok(case)
+    }
+
+    /// Reads `path`.
+    pub fn load(path: &Path) -> Result<Case> {
+        Case::from_json(&io::read_text(path)?, path)
+    }
+
+    /// Spacings of `tier` (empty when the case has none for it).
+    pub fn spacings(&self, tier: Tier) -> &[f64] {
+        self.sweep.dx.get(&tier).map(Vec::as_slice).unwrap_or(&[])
+    }
+
+    /// Presets that run in `tier`.
+    pub fn presets(&self, tier: Tier) -> impl Iterator<Item = &Preset> {
+        self.sweep.presets.iter().filter(move |p| p.tiers.as_ref().is_none_or(|t| t.contains(&tier)))
+    }
+
+    /// The primary preset (the first).
+    pub fn primary_preset(&self) -> &str {
+        self.sweep.presets.first().map(|p| p.name.as_str()).unwrap_or("")
+    }
+
+    /// Consistency checks beyond the schema.
+    fn check(&self) -> Result<()> {
+        let err = |m: String| HarnessError::case(&self.case, m);
+        if !self.scene.is_object() {
+            return Err(err("`scene` must be a JSON object (a full scene)".into()));
+        }
+        if self.sweep.presets.is_empty() {
+            return Err(err(
+                "`sweep.presets` is empty: give at least one (e.g. {\"name\": \"paper\", \"patch\": {}})"
+                    .into(),
+            ));
+        }
+        let mut names = std::collections::BTreeSet::new();
+        for p in &self.sweep.presets {
+            if p.name.is_empty() || !p.name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-')
+            {
+                return Err(err(format!("preset name `{}` must be non-empty [A-Za-z0-9_-]", p.name)));
+            }
+            if !names.insert(&p.name) {
+                return Err(err(format!("preset `{}` is defined twice", p.name)));
+            }
+        }
+        for (tier, dx) in &self.sweep.dx {
+            if let Some(bad) = dx.iter().find(|d| !(d.is_finite() && **d > 0.0)) {
+                return Err(err(format!("sweep.dx.{tier} has {bad}: spacings must be positive")));
+            }
+        }
+        for c in &self.checks {
+            c.validate().map_err(|m| err(format!("check `{}`: {m}", c.display_name())))?;
+        }
+        Ok(())
+    }
+}
+
+/// Finds case files: `validation/*.json` (sorted by name), or only the `names` given.
+pub fn discover(validation_dir: &Path, names: &[String]) -> Result<Vec<PathBuf>> {
+    if !names.is_empty() {
+        return names
+            .iter()
+            .map(|n| {
+                let p = validation_dir.join(format!("{n}.json"));
+                if p.is_file() { Ok(p) } else { Err(HarnessError::UnknownCase(n.clone())) }
+            })
+            .collect();
+    }
+    let rd = std::fs::read_dir(validation_dir)
+        .map_err(|source| HarnessError::Io { path: validation_dir.to_path_buf(), source })?;
+    let mut paths: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.is_file() && p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    paths.sort();
+    Ok(paths)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn repo_case() -> Case {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json");
+        Case::load(&path).expect("the committed case file parses")
+    }
+
+    #[test]
+    fn committed_elliptical_drop_case_is_consistent() {
+        let case = repo_case();
+        assert_eq!(case.case, "elliptical_drop");
+        assert_eq!(case.spacings(Tier::Quick), [0.04, 0.02]);
+        assert_eq!(case.spacings(Tier::Full).len(), 4);
+        assert_eq!(case.primary_preset(), "paper");
+        assert_eq!(case.presets(Tier::Quick).count(), 2);
+        assert!(case.checks.len() >= 8);
+        assert!(!case.errata.is_empty());
+    }
+
+    #[test]
+    fn rejects_duplicate_presets_and_unknown_fields() {
+        let mut v = serde_json::to_value(repo_case()).unwrap();
+        v["sweep"]["presets"][1]["name"] = "paper".into();
+        let e = Case::from_json(&v.to_string(), Path::new("x.json")).unwrap_err();
+        assert!(e.to_string().contains("twice"), "{e}");
+        let mut v = serde_json::to_value(repo_case()).unwrap();
+        v["bogus"] = 1.into();
+        assert!(Case::from_json(&v.to_string(), Path::new("x.json")).is_err());
+    }
+}

@@ -1,0 +1,441 @@
+//! Acceptance checks: generic over metrics, written as data in the case file.
+//!
+//! ```json
+//! { "name": "b error at dx=0.02 ≤ 1%", "metric": "b_rel_err_max", "select": { "dx": 0.02, "preset": "paper" }, "max": 0.01 }
+//! { "kind": "min", "metric": "min_pair_over_dx", "min": 0.5 }
+//! { "kind": "decreasing", "metric": "b_rel_err_max", "over": "dx", "select": { "preset": "paper" } }
+//! { "kind": "equals", "metric": "particles", "select": { "dx": 0.04 }, "value": 1976 }
+//! { "kind": "order", "metric": "u_profile_l2_rel", "select": { "preset": "paper" }, "min": 1.0 }
+//! ```
+//! `kind` defaults from the bound given (`max`, `min` or `value`). A check applies to the
+//! runs its `select` matches in the tier being run; a check matching no run (a spacing of
+//! another tier) is not applicable and is left out. A matching run that diverged, or a
+//! metric that is missing or not finite, fails the check (with a `note` saying why).
+
+use crate::case::Tier;
+use crate::fit::fit_power_law;
+use crate::results::RunResult;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Kinds of check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckKind {
+    /// Every selected run has `metric <= max`.
+    Max,
+    /// Every selected run has `metric >= min`.
+    Min,
+    /// Every selected run has `|metric - value| <= tolerance` (default 0: exact).
+    Equals,
+    /// The metric strictly decreases as dx decreases (per scheme and preset); the value is
+    /// the largest ratio `e(finer)/e(coarser)`, which must be below 1.
+    Decreasing,
+    /// The observed order in dx (least squares in log-log) is at least `min`.
+    Order,
+}
+
+/// Which runs a check applies to (all fields optional; absent = any).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Selector {
+    /// Spacing (matched to 1e-9 relative).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dx: Option<f64>,
+    /// Preset name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// Scheme name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scheme: Option<String>,
+}
+
+impl Selector {
+    /// Whether `run` matches.
+    pub fn matches(&self, run: &RunResult) -> bool {
+        self.dx.is_none_or(|d| (run.dx - d).abs() <= 1e-9 * d.abs())
+            && self.preset.as_ref().is_none_or(|p| *p == run.preset)
+            && self.scheme.as_ref().is_none_or(|s| *s == run.scheme)
+    }
+
+    fn describe(&self) -> String {
+        let mut parts = Vec::new();
+        if let Some(dx) = self.dx {
+            parts.push(format!("dx={dx}"));
+        }
+        if let Some(p) = &self.preset {
+            parts.push(p.clone());
+        }
+        if let Some(s) = &self.scheme {
+            parts.push(s.clone());
+        }
+        if parts.is_empty() { String::new() } else { format!(" ({})", parts.join(", ")) }
+    }
+}
+
+/// A check as written in the case file.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CheckSpec {
+    /// Display name (generated from the other fields when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Kind (inferred from `max` / `min` / `value` when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub kind: Option<CheckKind>,
+    /// Metric name (in `runs[].metrics`, or `particles` / `steps` / `wall_s`).
+    pub metric: String,
+    /// Runs the check applies to.
+    #[serde(default)]
+    pub select: Selector,
+    /// Upper bound (`max`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<f64>,
+    /// Lower bound (`min`, `order`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min: Option<f64>,
+    /// Expected value (`equals`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub value: Option<f64>,
+    /// Absolute tolerance of `equals` (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tolerance: Option<f64>,
+    /// Parameter of `decreasing` (only `dx`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub over: Option<String>,
+    /// Tiers in which the check applies (all when absent).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tiers: Option<Vec<Tier>>,
+}
+
+/// A check's outcome, as written to `results.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CheckResult {
+    /// Check name.
+    pub name: String,
+    /// Measured value (worst over the selected runs); `null` when it could not be measured.
+    pub value: Option<f64>,
+    /// The bound it is compared with (`decreasing`: 1, the largest allowed ratio).
+    pub threshold: Option<f64>,
+    /// Whether it passed.
+    pub pass: bool,
+    /// Why it failed when not because of the value (diverged run, missing metric).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+impl CheckSpec {
+    /// The kind, explicit or inferred from the bound given.
+    pub fn kind(&self) -> Option<CheckKind> {
+        self.kind.or(if self.max.is_some() {
+            Some(CheckKind::Max)
+        } else if self.min.is_some() {
+            Some(CheckKind::Min)
+        } else if self.value.is_some() {
+            Some(CheckKind::Equals)
+        } else {
+            None
+        })
+    }
+
+    /// The name shown in reports.
+    pub fn display_name(&self) -> String {
+        if let Some(n) = &self.name {
+            return n.clone();
+        }
+        let sel = self.select.describe();
+        let m = &self.metric;
+        match self.kind() {
+            Some(CheckKind::Max) => format!("{m}{sel} ≤ {}", self.max.unwrap_or(f64::NAN)),
+            Some(CheckKind::Min) => format!("{m}{sel} ≥ {}", self.min.unwrap_or(f64::NAN)),
+            Some(CheckKind::Equals) => format!("{m}{sel} = {}", self.value.unwrap_or(f64::NAN)),
+            Some(CheckKind::Decreasing) => format!("{m}{sel} decreases with dx"),
+            Some(CheckKind::Order) => format!("order of {m}{sel} ≥ {}", self.min.unwrap_or(f64::NAN)),
+            None => format!("{m}{sel}"),
+        }
+    }
+
+    /// Whether the spec is complete for its kind; the message says what is missing.
+    pub fn validate(&self) -> Result<(), String> {
+        let need = |v: Option<f64>, field: &str, kind: &str| match v {
+            Some(x) if x.is_finite() => Ok(()),
+            Some(x) => Err(format!("`{field}` = {x} must be finite")),
+            None => Err(format!("a `{kind}` check needs `{field}`")),
+        };
+        match self.kind() {
+            None => Err("give `kind` or one of `max`, `min`, `value`".into()),
+            Some(CheckKind::Max) => need(self.max, "max", "max"),
+            Some(CheckKind::Min) => need(self.min, "min", "min"),
+            Some(CheckKind::Order) => need(self.min, "min", "order"),
+            Some(CheckKind::Equals) => need(self.value, "value", "equals"),
+            Some(CheckKind::Decreasing) => match self.over.as_deref() {
+                None | Some("dx") => Ok(()),
+                Some(o) => Err(format!("`over` = {o:?}: only \"dx\" is supported")),
+            },
+        }
+    }
+
+    /// Evaluates the check on the runs of `tier`; `None` when it does not apply (no run
+    /// selected, another tier, or fewer than two spacings for `decreasing`/`order`).
+    pub fn evaluate(&self, runs: &[RunResult], tier: Tier) -> Option<CheckResult> {
+        if self.tiers.as_ref().is_some_and(|t| !t.contains(&tier)) {
+            return None;
+        }
+        let selected: Vec<&RunResult> = runs.iter().filter(|r| self.select.matches(r)).collect();
+        if selected.is_empty() {
+            return None;
+        }
+        let name = self.display_name();
+        let diverged: Vec<String> =
+            selected.iter().filter(|r| !r.ok()).map(|r| format!("{} {}", r.slug(), r.status)).collect();
+        let mut result = match self.kind()? {
+            CheckKind::Max => bound(&name, &selected, &self.metric, self.max?, |v, t| v <= t, f64::max),
+            CheckKind::Min => bound(&name, &selected, &self.metric, self.min?, |v, t| v >= t, f64::min),
+            CheckKind::Equals => {
+                let want = self.value?;
+                let tol = self.tolerance.unwrap_or(0.0);
+                // The worst value is the one farthest from the expected one.
+                let far = |a: f64, b: f64| if (a - want).abs() >= (b - want).abs() { a } else { b };
+                bound(&name, &selected, &self.metric, want, |v, t| (v - t).abs() <= tol, far)
+            }
+            CheckKind::Decreasing => decreasing(&name, &selected, &self.metric)?,
+            CheckKind::Order => order(&name, &selected, &self.metric, self.min?)?,
+        };
+        if !diverged.is_empty() {
+            result.pass = false;
+            result.note = Some(format!("diverged: {}", diverged.join("; ")));
+        }
+        Some(result)
+    }
+}
+
+/// `max` / `min` / `equals`: every selected run's metric against `threshold`.
+fn bound(
+    name: &str,
+    runs: &[&RunResult],
+    metric: &str,
+    threshold: f64,
+    ok: impl Fn(f64, f64) -> bool,
+    worst: impl Fn(f64, f64) -> f64,
+) -> CheckResult {
+    let mut value: Option<f64> = None;
+    let mut pass = true;
+    let mut missing = Vec::new();
+    for r in runs {
+        match r.metric(metric).filter(|v| v.is_finite()) {
+            Some(v) => {
+                pass &= ok(v, threshold);
+                value = Some(value.map_or(v, |w| worst(w, v)));
+            }
+            None => missing.push(r.slug()),
+        }
+    }
+    let note =
+        (!missing.is_empty()).then(|| format!("`{metric}` missing or not finite in {}", missing.join(", ")));
+    CheckResult {
+        name: name.to_string(),
+        value,
+        threshold: Some(threshold),
+        pass: pass && note.is_none(),
+        note,
+    }
+}
+
+/// Groups runs by (scheme, preset), each sorted from coarse to fine, with their metric.
+/// (scheme, preset) → `(dx, metric)` from coarse to fine.
+type Groups = BTreeMap<(String, String), Vec<(f64, Option<f64>)>>;
+
+fn by_group(runs: &[&RunResult], metric: &str) -> Groups {
+    let mut groups = Groups::new();
+    for r in runs {
+        groups
+            .entry((r.scheme.clone(), r.preset.clone()))
+            .or_default()
+            .push((r.dx, r.metric(metric).filter(|v| v.is_finite())));
+    }
+    for g in groups.values_mut() {
+        g.sort_by(|a, b| b.0.total_cmp(&a.0));
+    }
+    groups
+}
+
+fn decreasing(name: &str, runs: &[&RunResult], metric: &str) -> Option<CheckResult> {
+    let groups = by_group(runs, metric);
+    let mut worst: Option<f64> = None;
+    let mut note = None;
+    let mut applicable = false;
+    for ((scheme, preset), pts) in &groups {
+        for w in pts.windows(2) {
+            applicable = true;
+            match (w[0].1, w[1].1) {
+                (Some(coarse), Some(fine)) => {
+                    let ratio = if coarse > 0.0 { fine / coarse } else { f64::INFINITY };
+                    worst = Some(worst.map_or(ratio, |x| x.max(ratio)));
+                }
+                _ => note = Some(format!("`{metric}` missing in {scheme}-{preset}")),
+            }
+        }
+    }
+    if !applicable {
+        return None;
+    }
+    let pass = note.is_none() && worst.is_some_and(|w| w < 1.0);
+    Some(CheckResult { name: name.to_string(), value: worst, threshold: Some(1.0), pass, note })
+}
+
+fn order(name: &str, runs: &[&RunResult], metric: &str, min: f64) -> Option<CheckResult> {
+    let groups = by_group(runs, metric);
+    let mut worst: Option<f64> = None;
+    let mut applicable = false;
+    let mut note = None;
+    for ((scheme, preset), pts) in &groups {
+        if pts.len() < 2 {
+            continue;
+        }
+        applicable = true;
+        let dx: Vec<f64> = pts.iter().map(|p| p.0).collect();
+        let e: Vec<f64> = pts.iter().map(|p| p.1.unwrap_or(f64::NAN)).collect();
+        match fit_power_law(&dx, &e) {
+            Some(fit) => worst = Some(worst.map_or(fit.order, |w| w.min(fit.order))),
+            None => note = Some(format!("no order could be fitted for {scheme}-{preset}")),
+        }
+    }
+    if !applicable {
+        return None;
+    }
+    let pass = note.is_none() && worst.is_some_and(|w| w >= min);
+    Some(CheckResult { name: name.to_string(), value: worst, threshold: Some(min), pass, note })
+}
+
+/// Evaluates every applicable check of a case.
+pub fn evaluate_all(specs: &[CheckSpec], runs: &[RunResult], tier: Tier) -> Vec<CheckResult> {
+    specs.iter().filter_map(|c| c.evaluate(runs, tier)).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use serde_json::json;
+
+    fn run(preset: &str, dx: f64, err: f64, particles: usize, status: &str) -> RunResult {
+        RunResult {
+            scheme: "isph".into(),
+            preset: preset.into(),
+            dx,
+            particles,
+            steps: 400,
+            wall_s: 1.0,
+            status: status.into(),
+            metrics: [("b_rel_err_max".to_string(), err)].into(),
+            series: BTreeMap::new(),
+        }
+    }
+
+    fn spec(v: serde_json::Value) -> CheckSpec {
+        let s: CheckSpec = serde_json::from_value(v).unwrap();
+        s.validate().unwrap();
+        s
+    }
+
+    fn runs() -> Vec<RunResult> {
+        vec![
+            run("paper", 0.04, 0.02, 1976, "ok"),
+            run("paper", 0.02, 0.005, 7860, "ok"),
+            run("tuned", 0.04, 0.01, 1976, "ok"),
+            run("tuned", 0.02, 0.012, 7860, "ok"),
+        ]
+    }
+
+    #[test]
+    fn max_passes_and_fails() {
+        let c =
+            spec(json!({"metric": "b_rel_err_max", "select": {"dx": 0.02, "preset": "paper"}, "max": 0.01}));
+        let r = c.evaluate(&runs(), Tier::Quick).unwrap();
+        assert!(r.pass);
+        assert_eq!(r.value, Some(0.005));
+        assert_eq!(r.threshold, Some(0.01));
+        let c = spec(json!({"metric": "b_rel_err_max", "select": {"dx": 0.02}, "max": 0.01}));
+        let r = c.evaluate(&runs(), Tier::Quick).unwrap();
+        assert!(!r.pass, "the tuned run at 0.02 has 1.2 %");
+        assert_eq!(r.value, Some(0.012));
+        assert!(r.name.contains("b_rel_err_max (dx=0.02)"), "{}", r.name);
+    }
+
+    #[test]
+    fn min_kind() {
+        let c = spec(json!({"metric": "b_rel_err_max", "min": 0.006}));
+        let r = c.evaluate(&runs(), Tier::Quick).unwrap();
+        assert!(!r.pass);
+        assert_eq!(r.value, Some(0.005));
+    }
+
+    #[test]
+    fn decreasing_passes_and_fails() {
+        let c = spec(
+            json!({"kind": "decreasing", "metric": "b_rel_err_max", "over": "dx", "select": {"preset": "paper"}}),
+        );
+        let r = c.evaluate(&runs(), Tier::Quick).unwrap();
+        assert!(r.pass);
+        assert_eq!(r.value, Some(0.25));
+        let c = spec(json!({"kind": "decreasing", "metric": "b_rel_err_max"}));
+        let r = c.evaluate(&runs(), Tier::Quick).unwrap();
+        assert!(!r.pass, "tuned grows from 1.0 % to 1.2 %");
+        assert!((r.value.unwrap() - 1.2).abs() < 1e-12);
+        let one = vec![run("paper", 0.04, 0.02, 1976, "ok")];
+        assert!(c.evaluate(&one, Tier::Quick).is_none(), "one spacing: not applicable");
+    }
+
+    #[test]
+    fn equals_passes_and_fails_and_skips_other_tiers() {
+        let c = spec(json!({"kind": "equals", "metric": "particles", "select": {"dx": 0.04}, "value": 1976}));
+        let r = c.evaluate(&runs(), Tier::Quick).unwrap();
+        assert!(r.pass);
+        assert_eq!(r.value, Some(1976.0));
+        let c = spec(json!({"kind": "equals", "metric": "particles", "select": {"dx": 0.02}, "value": 7861}));
+        assert!(!c.evaluate(&runs(), Tier::Quick).unwrap().pass);
+        let c =
+            spec(json!({"kind": "equals", "metric": "particles", "select": {"dx": 0.01}, "value": 31428}));
+        assert!(c.evaluate(&runs(), Tier::Quick).is_none(), "no dx=0.01 run in this tier");
+        let c = spec(json!({"metric": "particles", "value": 1976, "tiers": ["full"]}));
+        assert!(c.evaluate(&runs(), Tier::Quick).is_none());
+    }
+
+    #[test]
+    fn order_kind() {
+        let c = spec(
+            json!({"kind": "order", "metric": "b_rel_err_max", "select": {"preset": "paper"}, "min": 1.5}),
+        );
+        let r = c.evaluate(&runs(), Tier::Quick).unwrap();
+        assert!(r.pass);
+        assert!((r.value.unwrap() - 2.0).abs() < 1e-12);
+        let c = spec(json!({"kind": "order", "metric": "b_rel_err_max", "min": 1.5}));
+        assert!(!c.evaluate(&runs(), Tier::Quick).unwrap().pass);
+    }
+
+    #[test]
+    fn diverged_or_missing_fails_with_a_note() {
+        let mut rs = runs();
+        rs[1].status = "diverged: stage `ppe` at step 3".into();
+        rs[1].metrics.insert("b_rel_err_max".into(), f64::NAN);
+        let c =
+            spec(json!({"metric": "b_rel_err_max", "select": {"dx": 0.02, "preset": "paper"}, "max": 0.01}));
+        let r = c.evaluate(&rs, Tier::Quick).unwrap();
+        assert!(!r.pass);
+        assert!(r.note.unwrap().contains("diverged"));
+        let c = spec(json!({"metric": "nonexistent", "max": 1.0}));
+        let r = c.evaluate(&runs(), Tier::Quick).unwrap();
+        assert!(!r.pass && r.value.is_none());
+    }
+
+    #[test]
+    fn incomplete_specs_are_rejected() {
+        let s: CheckSpec = serde_json::from_value(json!({"metric": "x"})).unwrap();
+        assert!(s.validate().is_err());
+        let s: CheckSpec = serde_json::from_value(json!({"kind": "max", "metric": "x"})).unwrap();
+        assert!(s.validate().unwrap_err().contains("max"));
+        let s: CheckSpec =
+            serde_json::from_value(json!({"kind": "decreasing", "metric": "x", "over": "t"})).unwrap();
+        assert!(s.validate().is_err());
+        assert!(serde_json::from_value::<CheckSpec>(json!({"metric": "x", "maximum": 1})).is_err());
+    }
+}

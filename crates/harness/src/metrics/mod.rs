@@ -1,0 +1,102 @@
+//! Metrics of a run against the case's analytical reference, per reference kind, plus the
+//! generic error norms they are built from.
+//!
+//! Metric names are snake_case with the quantity and the norm (DESIGN.md):
+//! `<quantity>_rel_err_max` (largest relative error over the recorded history),
+//! `<quantity>_rel_err_final` (at the last sample), `<quantity>_drift` (largest
+//! `|x(t) - x(0)| / |x(0)|`). Non-finite samples make the norm NaN (never silently skipped).
+
+pub mod elliptical_drop;
+
+use crate::case::ReferenceSpec;
+use meniscus::ProbeRecord;
+use std::collections::BTreeMap;
+
+/// Scalar metrics and plot series of one run.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Measured {
+    /// Scalar metrics by name.
+    pub metrics: BTreeMap<String, f64>,
+    /// Series by name, aligned with `series["t"]`.
+    pub series: BTreeMap<String, Vec<f64>>,
+}
+
+/// Computes the metrics of a run's probes against `reference`.
+pub fn compute(
+    reference: &ReferenceSpec,
+    probes: &ProbeRecord,
+    particles: usize,
+) -> Result<Measured, meniscus_reference::ReferenceError> {
+    let mut m = match *reference {
+        ReferenceSpec::EllipticalDrop { radius, a0, density } => {
+            elliptical_drop::compute(&elliptical_drop::Params { radius, a0, density }, probes)?
+        }
+    };
+    m.metrics.insert("particles".into(), particles as f64);
+    Ok(m)
+}
+
+/// Pointwise relative errors `|v - r| / |r|` of two aligned series.
+pub fn rel_errors(values: &[f64], reference: &[f64]) -> Vec<f64> {
+    values.iter().zip(reference).map(|(v, r)| ((v - r) / r).abs()).collect()
+}
+
+/// Largest pointwise relative error; NaN if any sample is not finite or the series is empty.
+pub fn rel_err_max(values: &[f64], reference: &[f64]) -> f64 {
+    nan_max(&rel_errors(values, reference))
+}
+
+/// Relative error at the last sample (NaN when empty).
+pub fn rel_err_final(values: &[f64], reference: &[f64]) -> f64 {
+    match (values.last(), reference.last()) {
+        (Some(v), Some(r)) => ((v - r) / r).abs(),
+        _ => f64::NAN,
+    }
+}
+
+/// Largest relative drift from the first sample, `max_t |x(t) - x(0)| / |x(0)|`.
+pub fn drift(values: &[f64]) -> f64 {
+    match values.first() {
+        Some(&x0) => nan_max(&values.iter().map(|x| ((x - x0) / x0).abs()).collect::<Vec<_>>()),
+        None => f64::NAN,
+    }
+}
+
+/// Maximum that propagates NaN (an unstable sample must not vanish from a max norm).
+pub fn nan_max(values: &[f64]) -> f64 {
+    if values.is_empty() {
+        return f64::NAN;
+    }
+    values.iter().fold(f64::NEG_INFINITY, |m, &v| if v.is_nan() || m.is_nan() { f64::NAN } else { m.max(v) })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn relative_error_norms() {
+        let reference = [1.0, 2.0, 4.0];
+        let values = [1.01, 1.9, 4.0];
+        assert!((rel_err_max(&values, &reference) - 0.05).abs() < 1e-12);
+        assert!(rel_err_final(&values, &reference).abs() < 1e-12);
+        assert!((rel_err_final(&[1.0, 4.4], &[1.0, 4.0]) - 0.1).abs() < 1e-12);
+        assert!(rel_err_max(&[], &[]).is_nan());
+        assert!(rel_err_final(&[], &[]).is_nan());
+    }
+
+    #[test]
+    fn nan_is_not_skipped() {
+        assert!(rel_err_max(&[1.0, f64::NAN, 1.0], &[1.0, 1.0, 1.0]).is_nan());
+        assert!(nan_max(&[0.1, f64::NAN]).is_nan());
+        assert!((nan_max(&[0.1, 0.3, 0.2]) - 0.3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn kinetic_energy_drift() {
+        let e = [100.0, 99.0, 101.5, 98.5];
+        assert!((drift(&e) - 0.015).abs() < 1e-12);
+        assert!(drift(&[5.0]).abs() < 1e-15);
+        assert!(drift(&[]).is_nan());
+    }
+}

@@ -1,0 +1,219 @@
+//! The report: SVG figures ([`plots`]) and self-contained HTML pages ([`html`]), rendered
+//! from the JSON in the output directory only (`cargo xtask report` runs nothing).
+//!
+//! Layout: `reports/index.html` (one row per case), `reports/summary.json`, and per case
+//! `reports/<case>/index.html` with its figures `reports/<case>/*.svg` (relative links).
+
+pub mod html;
+pub mod plots;
+
+use crate::case::Figure;
+use crate::error::Result;
+use crate::io;
+use crate::results::{CaseRecord, CaseResults, RunResult};
+use std::path::Path;
+
+/// A figure written next to a case page.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FigureFile {
+    /// File name relative to the case directory (`history_b_paper.svg`).
+    pub file: String,
+    /// Caption.
+    pub caption: String,
+}
+
+/// Renders the figures and the page of one case into `case_dir`; `record` (the case file
+/// and provenance) supplies the figure list, parameters, errata and provenance when present.
+pub fn render_case(
+    case_dir: &Path,
+    results: &CaseResults,
+    record: Option<&CaseRecord>,
+) -> Result<Vec<FigureFile>> {
+    let mut figures = Vec::new();
+    let runs: Vec<&RunResult> = results.runs.iter().collect();
+    let mut presets: Vec<&str> = Vec::new();
+    for r in &runs {
+        if !presets.contains(&r.preset.as_str()) {
+            presets.push(&r.preset);
+        }
+    }
+    for fig in record.map(|r| r.case.figures.as_slice()).unwrap_or(&[]) {
+        match fig {
+            Figure::History { file, title, y_label, series, reference } => {
+                for p in &presets {
+                    let mut mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p).collect();
+                    mine.sort_by(|a, b| b.dx.total_cmp(&a.dx));
+                    let name = format!("{file}_{p}.svg");
+                    let caption = format!("{title} — preset {p}");
+                    let svg = plots::history(&name, &caption, y_label, &mine, series, reference.as_deref())?;
+                    io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
+                    figures.push(FigureFile { file: name, caption });
+                }
+            }
+            Figure::Convergence { file, title, metrics, slope } => {
+                let name = format!("{file}.svg");
+                let svg = plots::convergence(&name, title, &runs, metrics, *slope)?;
+                io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
+                figures.push(FigureFile { file: name, caption: title.clone() });
+            }
+            Figure::Cost { file, title, metric } => {
+                let name = format!("{file}.svg");
+                let svg = plots::cost(&name, title, &runs, metric)?;
+                io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
+                figures.push(FigureFile { file: name, caption: title.clone() });
+            }
+        }
+    }
+    let page = html::case_page(results, record, &figures);
+    io::write_atomic(&case_dir.join("index.html"), page.as_bytes())?;
+    Ok(figures)
+}
+
+/// Every `<out>/<case>/results.json` present, sorted by case name.
+pub fn collect(out: &Path) -> Result<Vec<(CaseResults, Option<CaseRecord>)>> {
+    let mut found = Vec::new();
+    let Ok(rd) = std::fs::read_dir(out) else { return Ok(found) };
+    let mut dirs: Vec<_> =
+        rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.join("results.json").is_file()).collect();
+    dirs.sort();
+    for d in dirs {
+        let results: CaseResults = io::read_json(&d.join("results.json"))?;
+        let record: Option<CaseRecord> = io::read_json(&d.join("provenance.json")).ok();
+        found.push((results, record));
+    }
+    Ok(found)
+}
+
+/// Re-renders every case page, `summary.json` and `index.html` in `out` from the results
+/// files there; returns the results found.
+pub fn render_all(out: &Path) -> Result<Vec<CaseResults>> {
+    let found = collect(out)?;
+    for (results, record) in &found {
+        render_case(&out.join(&results.case), results, record.as_ref())?;
+    }
+    let results: Vec<CaseResults> = found.iter().map(|f| f.0.clone()).collect();
+    let summary = crate::validate::summary_of(&results);
+    io::write_json(&out.join("summary.json"), &summary)?;
+    let records: Vec<Option<&CaseRecord>> = found.iter().map(|f| f.1.as_ref()).collect();
+    let page = html::index_page(&results, &records, &summary);
+    io::write_atomic(&out.join("index.html"), page.as_bytes())?;
+    Ok(results)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::case::Case;
+    use crate::io::testing::Scratch;
+    use crate::provenance::Provenance;
+
+    /// A small hand-written results.json (two spacings, one diverged tuned run).
+    const FIXTURE: &str = r#"{
+      "case": "elliptical_drop", "scheme": "isph", "tier": "quick",
+      "runs": [
+        { "scheme": "isph", "preset": "paper", "dx": 0.04, "particles": 1976, "steps": 400, "wall_s": 1.2,
+          "status": "ok",
+          "metrics": { "particles": 1976, "a_rel_err_max": 0.012, "b_rel_err_max": 0.016, "pc_rel_err_final": 0.04, "ke_drift": 0.003 },
+          "series": { "t": [0.0, 0.004, 0.008], "b_moment": [1.003, 1.47, 2.01], "b_extent": [0.98, 1.45, 1.99],
+                      "b_ref": [1.0, 1.4647738, 1.9993020], "a_moment": [1.003, 0.69, 0.51], "a_ref": [1.0, 0.6827, 0.5002],
+                      "p": [5.0e6, 2.9e6, 1.1e6], "pc_ref": [5.0e6, 2.93e6, 1.108e6] } },
+        { "scheme": "isph", "preset": "paper", "dx": 0.02, "particles": 7860, "steps": 400, "wall_s": 6.5,
+          "status": "ok",
+          "metrics": { "particles": 7860, "a_rel_err_max": 0.004, "b_rel_err_max": 0.004, "pc_rel_err_final": 0.02, "ke_drift": 0.001 },
+          "series": { "t": [0.0, 0.004, 0.008], "b_moment": [1.001, 1.466, 2.003], "b_extent": [0.99, 1.46, 1.995],
+                      "b_ref": [1.0, 1.4647738, 1.9993020], "a_moment": [1.001, 0.684, 0.502], "a_ref": [1.0, 0.6827, 0.5002],
+                      "p": [5.0e6, 2.92e6, 1.105e6], "pc_ref": [5.0e6, 2.93e6, 1.108e6] } },
+        { "scheme": "isph", "preset": "tuned", "dx": 0.04, "particles": 1976, "steps": 120, "wall_s": 0.4,
+          "status": "diverged: diverged in stage `ppe` at step 120 (t = 2.4e-3 s): PPE did not converge",
+          "metrics": { "particles": 1976, "b_rel_err_max": null },
+          "series": { "t": [0.0, 0.002], "b_moment": [1.003, null] } }
+      ],
+      "convergence": { "b_rel_err_max": { "order": 2.0, "preset": "paper", "dx": [0.04, 0.02], "values": [0.016, 0.004], "by_preset": { "paper": 2.0 } } },
+      "checks": [
+        { "name": "b error (moments, max over history) at dx=0.02 ≤ 1%", "value": 0.004, "threshold": 0.01, "pass": true },
+        { "name": "tuned b error ≤ 1%", "value": null, "threshold": 0.01, "pass": false, "note": "diverged: isph-tuned_dx0.04" }
+      ]
+    }"#;
+
+    #[test]
+    fn renders_case_page_index_and_svgs_from_fixture() {
+        let dir = Scratch::new("report");
+        let out = dir.path();
+        let results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
+        io::write_json(&out.join("elliptical_drop/results.json"), &results).unwrap();
+        let case =
+            Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
+                .unwrap();
+        let record = CaseRecord {
+            case,
+            provenance: Provenance {
+                git_commit: Some("0123abc".into()),
+                threads: 2,
+                date_utc: "2025-01-01T00:00:00Z".into(),
+                ..Default::default()
+            },
+            scene_hashes: [("isph-paper_dx0.04".to_string(), "f00d".to_string())].into(),
+        };
+        io::write_json(&out.join("elliptical_drop/provenance.json"), &record).unwrap();
+
+        let all = render_all(out).unwrap();
+        assert_eq!(all.len(), 1);
+        let page = std::fs::read_to_string(out.join("elliptical_drop/index.html")).unwrap();
+        for needle in [
+            "<!DOCTYPE html>",
+            "elliptical_drop",
+            "isph-paper_dx0.02",
+            "b_rel_err_max",
+            "0.400 %",
+            "class=\"fail\"",
+            "class=\"pass\"",
+            "diverged: isph-tuned_dx0.04",
+            "history_b_paper.svg",
+            "convergence.svg",
+            "cost.svg",
+            "erratum 1",
+            "0123abc",
+            "2025-01-01T00:00:00Z",
+            "f00d",
+            "&quot;bicgstab&quot;",
+            "2.00",
+        ] {
+            assert!(page.contains(needle), "case page lacks {needle:?}");
+        }
+        assert!(!page.contains("<script"), "self-contained, no scripts");
+        for svg in [
+            "history_b_paper.svg",
+            "history_a_tuned.svg",
+            "pressure_paper.svg",
+            "convergence.svg",
+            "cost.svg",
+        ] {
+            let text = std::fs::read_to_string(out.join("elliptical_drop").join(svg)).unwrap();
+            assert!(text.starts_with("<svg") && text.contains("</svg>"), "{svg}");
+        }
+        let conv = std::fs::read_to_string(out.join("elliptical_drop/convergence.svg")).unwrap();
+        assert!(conv.contains("b_rel_err_max (paper): order 2.00"), "legend shows the fitted order");
+        assert!(conv.contains("reference slope dx^2"));
+        let hist = std::fs::read_to_string(out.join("elliptical_drop/history_b_paper.svg")).unwrap();
+        assert!(hist.contains("b_ref (reference)") && hist.contains("dx=0.02"));
+
+        let index = std::fs::read_to_string(out.join("index.html")).unwrap();
+        for needle in ["elliptical_drop/index.html", "isph", "0.04, 0.02", "1 / 2", "FAIL", "2.00"] {
+            assert!(index.contains(needle), "index lacks {needle:?}");
+        }
+        let summary: crate::results::Summary = io::read_json(&out.join("summary.json")).unwrap();
+        assert!(!summary.pass);
+        assert_eq!((summary.passed, summary.failed), (1, 1));
+        assert_eq!(summary.cases[0].diverged, 1);
+    }
+
+    #[test]
+    fn renders_without_a_provenance_record() {
+        let dir = Scratch::new("report-bare");
+        let results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
+        let figs = render_case(dir.path(), &results, None).unwrap();
+        assert!(figs.is_empty());
+        let page = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+        assert!(page.contains("isph-paper_dx0.04"));
+    }
+}

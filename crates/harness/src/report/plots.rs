@@ -1,0 +1,292 @@
+//! SVG figures (plotters, SVG backend only; text is emitted as `<text>` elements, so no
+//! font library is needed). Every function draws from `results.json` data only.
+
+use crate::error::{HarnessError, Result};
+use crate::fit::fit_power_law;
+use crate::results::RunResult;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Figure size in pixels.
+const SIZE: (u32, u32) = (760, 440);
+
+/// Line colours, one per resolution (or metric).
+const COLOURS: [RGBColor; 8] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(23, 190, 207),
+];
+
+fn colour(i: usize) -> RGBColor {
+    COLOURS[i % COLOURS.len()]
+}
+
+fn plot_err(file: &str) -> impl Fn(Box<dyn std::fmt::Debug>) -> HarnessError + '_ {
+    move |e| HarnessError::Plot { file: file.to_string(), message: format!("{e:?}") }
+}
+
+/// `(min, max)` of the finite values, padded by `pad` of the span (never empty).
+fn range(values: impl Iterator<Item = f64>, pad: f64) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite())
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+    if !lo.is_finite() {
+        return (0.0, 1.0);
+    }
+    let span = if hi > lo { hi - lo } else { lo.abs().max(1.0) * 0.1 };
+    (lo - pad * span, hi + pad * span)
+}
+
+/// `(min, max)` of the positive finite values for a log axis, widened by `factor` each side.
+fn log_range(values: impl Iterator<Item = f64>, factor: f64) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+    if !lo.is_finite() { (1e-3, 1.0) } else { (lo / factor, hi * factor) }
+}
+
+fn finite_points(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
+    x.iter().zip(y).filter(|(a, b)| a.is_finite() && b.is_finite()).map(|(a, b)| (*a, *b)).collect()
+}
+
+fn svg(
+    draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> std::result::Result<(), Box<dyn std::fmt::Debug>>,
+) -> std::result::Result<String, Box<dyn std::fmt::Debug>> {
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, SIZE).into_drawing_area();
+        root.fill(&WHITE).map_err(boxed)?;
+        draw(&root)?;
+        root.present().map_err(boxed)?;
+    }
+    Ok(out)
+}
+
+fn boxed<E: std::fmt::Debug + 'static>(e: E) -> Box<dyn std::fmt::Debug> {
+    Box::new(e)
+}
+
+/// Time histories: `series` of every run (one colour per run, solid for the first series,
+/// dashed for the others) and the `reference` series of the finest run in black.
+pub fn history(
+    file: &str,
+    title: &str,
+    y_label: &str,
+    runs: &[&RunResult],
+    series: &[String],
+    reference: Option<&str>,
+) -> Result<String> {
+    let t_of = |r: &RunResult| r.series.get("t").cloned().unwrap_or_default();
+    let mut all_y = Vec::new();
+    let mut all_t = Vec::new();
+    for r in runs {
+        all_t.extend(t_of(r));
+        for s in series.iter().map(String::as_str).chain(reference) {
+            all_y.extend(r.series.get(s).into_iter().flatten().copied());
+        }
+    }
+    let (t0, t1) = range(all_t.into_iter(), 0.0);
+    let (y0, y1) = range(all_y.into_iter(), 0.05);
+    let finest = runs.iter().filter(|r| r.ok()).min_by(|a, b| a.dx.total_cmp(&b.dx)).or(runs.first());
+    svg(|root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(t0..t1, y0..y1)
+            .map_err(boxed)?;
+        chart.configure_mesh().x_desc("t [s]").y_desc(y_label).draw().map_err(boxed)?;
+        if let (Some(r), Some(name)) = (finest, reference)
+            && let Some(v) = r.series.get(name)
+        {
+            chart
+                .draw_series(LineSeries::new(finite_points(&t_of(r), v), BLACK.stroke_width(2)))
+                .map_err(boxed)?
+                .label(format!("{name} (reference)"))
+                .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+        }
+        for (i, r) in runs.iter().enumerate() {
+            let c = colour(i);
+            let t = t_of(r);
+            for (j, s) in series.iter().enumerate() {
+                let Some(v) = r.series.get(s) else { continue };
+                let pts = finite_points(&t, v);
+                let label =
+                    format!("{s}, {} dx={}{}", r.preset, r.dx, if r.ok() { "" } else { " (diverged)" });
+                if j == 0 {
+                    chart
+                        .draw_series(LineSeries::new(pts, c.stroke_width(2)))
+                        .map_err(boxed)?
+                        .label(label)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+                } else {
+                    chart
+                        .draw_series(DashedLineSeries::new(pts, 6, 4, c.stroke_width(1)))
+                        .map_err(boxed)?
+                        .label(label)
+                        .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], c.stroke_width(1)));
+                }
+            }
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperLeft)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(boxed)?;
+        Ok(())
+    })
+    .map_err(plot_err(file))
+}
+
+/// Error against dx in log-log: one line per metric and preset, labelled with the fitted
+/// order, and a reference line of slope `slope` through the finest point of the first.
+pub fn convergence(
+    file: &str,
+    title: &str,
+    runs: &[&RunResult],
+    metrics: &[String],
+    slope: Option<f64>,
+) -> Result<String> {
+    let mut presets: Vec<&str> = runs.iter().map(|r| r.preset.as_str()).collect();
+    presets.dedup();
+    presets.sort_unstable();
+    presets.dedup();
+    // (label, colour index, preset index, points coarse -> fine)
+    let mut lines = Vec::new();
+    for (mi, m) in metrics.iter().enumerate() {
+        for (pi, p) in presets.iter().enumerate() {
+            let mut pts: Vec<(f64, f64)> = runs
+                .iter()
+                .filter(|r| r.preset == *p && r.ok())
+                .filter_map(|r| r.metric(m).map(|v| (r.dx, v)))
+                .filter(|(d, v)| *d > 0.0 && *v > 0.0 && v.is_finite())
+                .collect();
+            pts.sort_by(|a, b| b.0.total_cmp(&a.0));
+            if pts.is_empty() {
+                continue;
+            }
+            let (dx, e): (Vec<f64>, Vec<f64>) = pts.iter().copied().unzip();
+            let order = fit_power_law(&dx, &e).map_or("n/a".to_string(), |f| format!("{:.2}", f.order));
+            lines.push((format!("{m} ({p}): order {order}"), mi, pi, pts));
+        }
+    }
+    let (x0, x1) = log_range(lines.iter().flat_map(|l| l.3.iter().map(|p| p.0)), 1.3);
+    let (y0, y1) = log_range(lines.iter().flat_map(|l| l.3.iter().map(|p| p.1)), 2.0);
+    svg(|root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .map_err(boxed)?;
+        chart
+            .configure_mesh()
+            .x_desc("dx [m]")
+            .y_desc("relative error")
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(boxed)?;
+        for (label, mi, pi, pts) in &lines {
+            let c = colour(*mi);
+            let style = if *pi == 0 { c.stroke_width(2) } else { c.stroke_width(1) };
+            chart
+                .draw_series(LineSeries::new(pts.clone(), style))
+                .map_err(boxed)?
+                .label(label.clone())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
+            let marker = *pi;
+            chart
+                .draw_series(pts.iter().map(move |&p| -> DynElement<SVGBackend, (f64, f64)> {
+                    if marker == 0 {
+                        Circle::new(p, 4, c.filled()).into_dyn()
+                    } else {
+                        TriangleMarker::new(p, 5, c.filled()).into_dyn()
+                    }
+                }))
+                .map_err(boxed)?;
+        }
+        if let (Some(s), Some(first)) = (slope, lines.first()) {
+            let &(dxf, ef) = first.3.last().expect("non-empty");
+            let c = ef / dxf.powf(s);
+            let pts: Vec<(f64, f64)> = [x0 * 1.1, x1 / 1.1].iter().map(|&d| (d, c * d.powf(s))).collect();
+            let grey = RGBColor(120, 120, 120);
+            chart
+                .draw_series(DashedLineSeries::new(pts, 6, 4, grey.stroke_width(1)))
+                .map_err(boxed)?
+                .label(format!("reference slope dx^{s}"))
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], grey));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(boxed)?;
+        Ok(())
+    })
+    .map_err(plot_err(file))
+}
+
+/// Work-precision: wall time against `metric`, one point per run, one colour per preset.
+pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Result<String> {
+    let pts: Vec<(String, f64, f64, f64)> = runs
+        .iter()
+        .filter(|r| r.ok())
+        .filter_map(|r| r.metric(metric).map(|e| (r.preset.clone(), r.dx, e, r.wall_s)))
+        .filter(|p| p.2 > 0.0 && p.2.is_finite() && p.3 > 0.0)
+        .collect();
+    let mut presets: Vec<&str> = pts.iter().map(|p| p.0.as_str()).collect();
+    presets.sort_unstable();
+    presets.dedup();
+    let (x0, x1) = log_range(pts.iter().map(|p| p.2), 2.0);
+    let (y0, y1) = log_range(pts.iter().map(|p| p.3), 2.0);
+    svg(|root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .map_err(boxed)?;
+        chart
+            .configure_mesh()
+            .x_desc(metric)
+            .y_desc("wall time [s]")
+            .x_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(boxed)?;
+        for (i, p) in presets.iter().enumerate() {
+            let c = colour(i);
+            let mine: Vec<&(String, f64, f64, f64)> = pts.iter().filter(|q| q.0 == *p).collect();
+            chart
+                .draw_series(mine.iter().map(|q| Circle::new((q.2, q.3), 5, c.filled())))
+                .map_err(boxed)?
+                .label(p.to_string())
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+            chart
+                .draw_series(
+                    mine.iter().map(|q| Text::new(format!("dx={}", q.1), (q.2, q.3), ("sans-serif", 12))),
+                )
+                .map_err(boxed)?;
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::UpperRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(boxed)?;
+        Ok(())
+    })
+    .map_err(plot_err(file))
+}

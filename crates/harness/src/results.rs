@@ -1,0 +1,227 @@
+//! The results files (DESIGN.md "Results files"): `reports/<case>/results.json`,
+//! `reports/summary.json`, and the provenance/case copies the report pages read.
+
+use crate::case::Case;
+use crate::checks::CheckResult;
+use crate::provenance::Provenance;
+use serde::{Deserialize, Deserializer, Serialize};
+use std::collections::BTreeMap;
+
+/// One run of the sweep, as it appears in `results.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunResult {
+    /// Scheme of the run (`isph`).
+    pub scheme: String,
+    /// Preset (option set) name.
+    pub preset: String,
+    /// Particle spacing \[m\].
+    pub dx: f64,
+    /// Number of particles.
+    pub particles: usize,
+    /// Steps taken.
+    pub steps: usize,
+    /// Wall time of the run \[s\].
+    pub wall_s: f64,
+    /// `ok` or `diverged: <cause at step/time>`.
+    pub status: String,
+    /// Scalar metrics (non-finite values are written as `null`).
+    #[serde(deserialize_with = "nan_map")]
+    pub metrics: BTreeMap<String, f64>,
+    /// Series for plots, each aligned with `series.t`.
+    #[serde(deserialize_with = "nan_series")]
+    pub series: BTreeMap<String, Vec<f64>>,
+}
+
+impl RunResult {
+    /// Whether the run reached its end time.
+    pub fn ok(&self) -> bool {
+        self.status == "ok"
+    }
+
+    /// The stable run slug, e.g. `isph-paper_dx0.02`.
+    pub fn slug(&self) -> String {
+        slug(&self.scheme, &self.preset, self.dx)
+    }
+
+    /// A metric, falling back to the run's own numeric fields (`particles`, `steps`,
+    /// `wall_s`); `None` when absent.
+    pub fn metric(&self, name: &str) -> Option<f64> {
+        self.metrics.get(name).copied().or(match name {
+            "particles" => Some(self.particles as f64),
+            "steps" => Some(self.steps as f64),
+            "wall_s" => Some(self.wall_s),
+            _ => None,
+        })
+    }
+}
+
+/// The stable slug of a run: `<scheme>-<preset>_dx<dx>` (dx in shortest decimal form).
+pub fn slug(scheme: &str, preset: &str, dx: f64) -> String {
+    format!("{scheme}-{preset}_dx{dx}")
+}
+
+/// Observed order of one metric.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Convergence {
+    /// Observed order of the primary preset (least squares in log-log).
+    pub order: f64,
+    /// The preset the order belongs to.
+    pub preset: String,
+    /// Spacings used \[m\].
+    pub dx: Vec<f64>,
+    /// The metric at those spacings.
+    pub values: Vec<f64>,
+    /// Orders of every preset with at least two spacings.
+    #[serde(default)]
+    pub by_preset: BTreeMap<String, f64>,
+}
+
+/// `reports/<case>/results.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseResults {
+    /// Case name.
+    pub case: String,
+    /// Default scheme of the case.
+    pub scheme: String,
+    /// Tier run.
+    pub tier: String,
+    /// Every run of the sweep (diverged ones included).
+    pub runs: Vec<RunResult>,
+    /// Observed orders, per metric.
+    pub convergence: BTreeMap<String, Convergence>,
+    /// Acceptance checks.
+    pub checks: Vec<CheckResult>,
+}
+
+impl CaseResults {
+    /// Number of passed and failed checks.
+    pub fn counts(&self) -> (usize, usize) {
+        let passed = self.checks.iter().filter(|c| c.pass).count();
+        (passed, self.checks.len() - passed)
+    }
+
+    /// Whether every check passed.
+    pub fn pass(&self) -> bool {
+        self.checks.iter().all(|c| c.pass)
+    }
+}
+
+/// One case in `reports/summary.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseSummary {
+    /// Case name.
+    pub case: String,
+    /// Default scheme.
+    pub scheme: String,
+    /// Tier run.
+    pub tier: String,
+    /// Number of runs.
+    pub runs: usize,
+    /// Runs that diverged.
+    pub diverged: usize,
+    /// Checks passed.
+    pub passed: usize,
+    /// Checks failed.
+    pub failed: usize,
+    /// Whether every check passed.
+    pub pass: bool,
+    /// Sum of the runs' wall times \[s\].
+    pub wall_s: f64,
+}
+
+impl CaseSummary {
+    /// Summarises one case's results.
+    pub fn of(results: &CaseResults) -> Self {
+        let (passed, failed) = results.counts();
+        CaseSummary {
+            case: results.case.clone(),
+            scheme: results.scheme.clone(),
+            tier: results.tier.clone(),
+            runs: results.runs.len(),
+            diverged: results.runs.iter().filter(|r| !r.ok()).count(),
+            passed,
+            failed,
+            pass: failed == 0,
+            wall_s: results.runs.iter().map(|r| r.wall_s).sum(),
+        }
+    }
+}
+
+/// `reports/summary.json`: every case with its pass/fail counts.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Summary {
+    /// Whether every check of every case passed.
+    pub pass: bool,
+    /// Checks passed over all cases.
+    pub passed: usize,
+    /// Checks failed over all cases.
+    pub failed: usize,
+    /// One entry per case, sorted by name.
+    pub cases: Vec<CaseSummary>,
+}
+
+impl Summary {
+    /// Builds the summary from per-case summaries (sorted by case name).
+    pub fn new(mut cases: Vec<CaseSummary>) -> Self {
+        cases.sort_by(|a, b| a.case.cmp(&b.case));
+        cases.dedup_by(|a, b| a.case == b.case);
+        let passed = cases.iter().map(|c| c.passed).sum();
+        let failed = cases.iter().map(|c| c.failed).sum();
+        Summary { pass: cases.iter().all(|c| c.pass), passed, failed, cases }
+    }
+}
+
+/// Side file `reports/<case>/provenance.json`: the case file as run and where/when/what
+/// produced the results (kept out of results.json to keep that contract exact).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseRecord {
+    /// The case file as it was when the results were produced.
+    pub case: Case,
+    /// Machine, commit, date.
+    pub provenance: Provenance,
+    /// SHA-256 of each run's effective scene, by slug.
+    pub scene_hashes: BTreeMap<String, String>,
+}
+
+fn nan_map<'de, D: Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>, D::Error> {
+    let m: BTreeMap<String, Option<f64>> = Deserialize::deserialize(d)?;
+    Ok(m.into_iter().map(|(k, v)| (k, v.unwrap_or(f64::NAN))).collect())
+}
+
+fn nan_series<'de, D: Deserializer<'de>>(d: D) -> Result<BTreeMap<String, Vec<f64>>, D::Error> {
+    let m: BTreeMap<String, Vec<Option<f64>>> = Deserialize::deserialize(d)?;
+    Ok(m.into_iter().map(|(k, v)| (k, v.into_iter().map(|x| x.unwrap_or(f64::NAN)).collect())).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn slug_is_stable() {
+        assert_eq!(slug("isph", "paper", 0.02), "isph-paper_dx0.02");
+        assert_eq!(slug("isph", "tuned", 0.005), "isph-tuned_dx0.005");
+    }
+
+    #[test]
+    fn non_finite_values_round_trip_as_null() {
+        let run = RunResult {
+            scheme: "isph".into(),
+            preset: "paper".into(),
+            dx: 0.04,
+            particles: 10,
+            steps: 3,
+            wall_s: 0.1,
+            status: "diverged: x".into(),
+            metrics: [("a".to_string(), f64::NAN)].into(),
+            series: [("t".to_string(), vec![0.0, f64::INFINITY])].into(),
+        };
+        let text = serde_json::to_string(&run).unwrap();
+        assert!(text.contains("\"a\":null"), "{text}");
+        let back: RunResult = serde_json::from_str(&text).unwrap();
+        assert!(back.metrics["a"].is_nan() && back.series["t"][1].is_nan());
+        assert!(!back.ok());
+        assert_eq!(back.metric("particles"), Some(10.0));
+        assert_eq!(back.metric("nope"), None);
+    }
+}

@@ -1,0 +1,145 @@
+//! Expands a case into runs (tier spacings × presets) and executes one run in-process.
+
+use crate::cache::{CachedProbes, RunRecord, sha256_hex};
+use crate::case::{Case, Tier};
+use crate::error::{HarnessError, Result};
+use crate::patch::merge_patch;
+use crate::results::slug;
+
+/// One parameter point of a sweep, with its effective scene.
+#[derive(Debug, Clone)]
+pub struct RunSpec {
+    /// Scheme (the key of the scene's `scheme` object).
+    pub scheme: String,
+    /// Preset name.
+    pub preset: String,
+    /// Spacing \[m\].
+    pub dx: f64,
+    /// Stable slug, e.g. `isph-paper_dx0.02`.
+    pub slug: String,
+    /// The parsed and validated effective scene.
+    pub scene: meniscus::Scene,
+    /// The effective scene as JSON (canonical: the typed scene re-serialised, defaults
+    /// included), which is what `hash` covers.
+    pub scene_json: serde_json::Value,
+    /// SHA-256 of the canonical scene JSON.
+    pub hash: String,
+}
+
+/// The effective scene JSON of `preset` at spacing `dx`: template, merge patch, `dx`.
+pub fn effective_scene(case: &Case, preset: &str, dx: f64) -> Result<serde_json::Value> {
+    let p = case
+        .sweep
+        .presets
+        .iter()
+        .find(|p| p.name == preset)
+        .ok_or_else(|| HarnessError::case(&case.case, format!("no preset `{preset}`")))?;
+    let mut scene = case.scene.clone();
+    merge_patch(&mut scene, &p.patch);
+    scene["dx"] = serde_json::json!(dx);
+    Ok(scene)
+}
+
+/// Builds the run of `preset` at `dx` (the scene is checked by the solver's parser).
+pub fn spec(case: &Case, preset: &str, dx: f64) -> Result<RunSpec> {
+    let value = effective_scene(case, preset, dx)?;
+    let scheme = value["scheme"]
+        .as_object()
+        .and_then(|m| m.keys().next().cloned())
+        .unwrap_or_else(|| case.scheme.clone());
+    let slug = slug(&scheme, preset, dx);
+    let scene = meniscus::Scene::from_json(&value.to_string()).map_err(|source| HarnessError::Scene {
+        case: case.case.clone(),
+        run: slug.clone(),
+        source,
+    })?;
+    let canonical = serde_json::to_value(&scene)
+        .map_err(|e| HarnessError::case(&case.case, format!("run {slug}: scene does not serialise: {e}")))?;
+    let hash = sha256_hex(&canonical.to_string());
+    Ok(RunSpec { scheme, preset: preset.to_string(), dx, slug, scene, scene_json: canonical, hash })
+}
+
+/// Every run of `case` in `tier`: spacings from coarse to fine, presets in file order.
+pub fn expand(case: &Case, tier: Tier) -> Result<Vec<RunSpec>> {
+    let mut dx = case.spacings(tier).to_vec();
+    if dx.is_empty() {
+        return Err(HarnessError::case(&case.case, format!("no spacings for tier `{tier}` in sweep.dx")));
+    }
+    dx.sort_by(|a, b| b.total_cmp(a));
+    dx.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
+    let presets: Vec<&str> = case.presets(tier).map(|p| p.name.as_str()).collect();
+    let mut out = Vec::with_capacity(dx.len() * presets.len());
+    for &d in &dx {
+        for p in &presets {
+            out.push(spec(case, p, d)?);
+        }
+    }
+    Ok(out)
+}
+
+/// Runs `spec` through the solver (a diverged run is a record with status `diverged`).
+pub fn execute(spec: &RunSpec, observer: &mut dyn meniscus::Observer) -> Result<RunRecord> {
+    let report = meniscus::run(&spec.scene, observer).map_err(|source| HarnessError::Scene {
+        case: spec.scene.name.clone(),
+        run: spec.slug.clone(),
+        source,
+    })?;
+    Ok(RunRecord {
+        completed: true,
+        slug: spec.slug.clone(),
+        scheme: spec.scheme.clone(),
+        preset: spec.preset.clone(),
+        dx: spec.dx,
+        scene_hash: spec.hash.clone(),
+        scene: spec.scene_json.clone(),
+        summary: report.summary,
+        probes: CachedProbes::from(report.probes),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::path::Path;
+
+    fn case() -> Case {
+        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
+            .unwrap()
+    }
+
+    #[test]
+    fn expands_tier_into_slugged_runs() {
+        let runs = expand(&case(), Tier::Quick).unwrap();
+        let slugs: Vec<&str> = runs.iter().map(|r| r.slug.as_str()).collect();
+        assert_eq!(
+            slugs,
+            ["isph-paper_dx0.04", "isph-tuned_dx0.04", "isph-paper_dx0.02", "isph-tuned_dx0.02"]
+        );
+        assert!((runs[2].scene.dx - 0.02).abs() < 1e-15);
+        assert_eq!(runs[1].scene_json["scheme"]["isph"]["ppe"]["solver"], "cg");
+        assert_eq!(runs[1].scene_json["scheme"]["isph"]["pressure_gradient"], "difference");
+        assert_eq!(runs[0].scene_json["scheme"]["isph"]["ppe"]["solver"], "bicgstab");
+        assert_eq!(runs[0].hash.len(), 64);
+        assert_ne!(runs[0].hash, runs[1].hash);
+        assert_ne!(runs[0].hash, runs[2].hash);
+        assert_eq!(expand(&case(), Tier::Full).unwrap().len(), 8);
+    }
+
+    #[test]
+    fn hash_is_stable_and_follows_the_scene() {
+        let c = case();
+        let a = spec(&c, "paper", 0.04).unwrap();
+        assert_eq!(a.hash, spec(&c, "paper", 0.04).unwrap().hash);
+        let mut changed = c.clone();
+        changed.scene["time"]["end"] = serde_json::json!(0.004);
+        assert_ne!(a.hash, spec(&changed, "paper", 0.04).unwrap().hash);
+    }
+
+    #[test]
+    fn bad_preset_patch_names_the_run() {
+        let mut c = case();
+        c.sweep.presets[1].patch = serde_json::json!({"fluid": {"density": -1.0}});
+        let e = expand(&c, Tier::Quick).unwrap_err().to_string();
+        assert!(e.contains("isph-tuned_dx0.04") && e.contains("density"), "{e}");
+    }
+}

@@ -1,0 +1,362 @@
+//! `cargo xtask validate`: run every case's sweep (reusing cached runs), compute metrics,
+//! orders and checks, write the results files and render the report.
+
+use crate::cache::{self, RunRecord};
+use crate::case::{self, Case, Tier};
+use crate::checks::evaluate_all;
+use crate::error::{HarnessError, Result};
+use crate::fit::fit_power_law;
+use crate::io;
+use crate::metrics;
+use crate::progress::Progress;
+use crate::provenance::Provenance;
+use crate::report;
+use crate::results::{CaseRecord, CaseResults, Convergence, RunResult, Summary};
+use crate::sweep::{self, RunSpec};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+/// Options of a validation.
+#[derive(Debug, Clone)]
+pub struct ValidateOptions {
+    /// Tier to run.
+    pub tier: Tier,
+    /// Cases to run (all in `validation_dir` when empty).
+    pub cases: Vec<String>,
+    /// Output directory (`reports/`).
+    pub out: PathBuf,
+    /// Directory of the case files (`validation/`).
+    pub validation_dir: PathBuf,
+    /// Workspace root (for git provenance).
+    pub workspace: PathBuf,
+    /// Rerun even when a cached run is valid.
+    pub force: bool,
+    /// Runs executed concurrently (1 = sequential).
+    pub jobs: usize,
+    /// Show progress bars.
+    pub progress: bool,
+}
+
+/// What a validation produced.
+#[derive(Debug, Clone)]
+pub struct Outcome {
+    /// Results of the cases run by this invocation.
+    pub results: Vec<CaseResults>,
+    /// Runs executed (not taken from the cache).
+    pub executed: usize,
+    /// Runs taken from the cache.
+    pub reused: usize,
+}
+
+impl Outcome {
+    /// Whether every check of every case run passed (the exit code).
+    pub fn pass(&self) -> bool {
+        self.results.iter().all(CaseResults::pass)
+    }
+}
+
+/// Runs the validation described by `opts`; failed checks are results, not errors.
+pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
+    let paths = case::discover(&opts.validation_dir, &opts.cases)?;
+    let cases: Vec<Case> = paths.iter().map(|p| Case::load(p)).collect::<Result<_>>()?;
+    let progress = Progress::new(opts.progress);
+    let provenance = Provenance::collect(&opts.workspace);
+    let mut outcome = Outcome { results: Vec::new(), executed: 0, reused: 0 };
+    for case in &cases {
+        let specs = sweep::expand(case, opts.tier)?;
+        let case_dir = opts.out.join(&case.case);
+        let bar = progress.case_bar(&case.case, specs.len());
+        let (records, executed) = run_specs(&specs, &case_dir, opts, &progress, &bar)?;
+        bar.finish_with_message(format!("{executed} run, {} cached", specs.len() - executed));
+        outcome.executed += executed;
+        outcome.reused += specs.len() - executed;
+        let results = assemble(case, opts.tier, &records)?;
+        let record = CaseRecord {
+            case: case.clone(),
+            provenance: provenance.clone(),
+            scene_hashes: records.iter().map(|r| (r.slug.clone(), r.scene_hash.clone())).collect(),
+        };
+        io::write_json(&case_dir.join("results.json"), &results)?;
+        io::write_json(&case_dir.join("provenance.json"), &record)?;
+        let (passed, failed) = results.counts();
+        progress.println(&format!(
+            "{}: {passed} checks passed, {failed} failed -> {}",
+            case.case,
+            case_dir.join("index.html").display()
+        ));
+        outcome.results.push(results);
+    }
+    report::render_all(&opts.out)?;
+    Ok(outcome)
+}
+
+/// Runs (or reuses) every spec of a case; returns the records in spec order and how many
+/// were executed. With `jobs > 1`, that many runs go concurrently.
+fn run_specs(
+    specs: &[RunSpec],
+    case_dir: &Path,
+    opts: &ValidateOptions,
+    progress: &Progress,
+    bar: &indicatif::ProgressBar,
+) -> Result<(Vec<RunRecord>, usize)> {
+    let slots: Vec<Mutex<Option<Result<RunRecord>>>> = specs.iter().map(|_| Mutex::new(None)).collect();
+    let mut todo = Vec::new();
+    for (i, spec) in specs.iter().enumerate() {
+        let cached = if opts.force {
+            None
+        } else {
+            cache::load(&cache::record_path(case_dir, &spec.slug), &spec.hash)
+        };
+        match cached {
+            Some(r) => {
+                *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(Ok(r));
+                bar.inc(1);
+            }
+            None => todo.push(i),
+        }
+    }
+    let next = AtomicUsize::new(0);
+    let worker = || {
+        loop {
+            let k = next.fetch_add(1, Ordering::Relaxed);
+            let Some(&i) = todo.get(k) else { break };
+            let spec = &specs[i];
+            let mut run_bar = progress.run_bar(&spec.slug);
+            let result = sweep::execute(spec, &mut run_bar).and_then(|record| {
+                cache::store(&cache::record_path(case_dir, &spec.slug), &record)?;
+                Ok(record)
+            });
+            run_bar.finish();
+            if let Ok(r) = &result {
+                progress.println(&format!("  {} {} ({:.1} s)", r.slug, status(r), r.summary.wall_s));
+            }
+            bar.inc(1);
+            *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
+        }
+    };
+    let jobs = opts.jobs.clamp(1, todo.len().max(1));
+    if jobs == 1 {
+        worker();
+    } else {
+        std::thread::scope(|s| {
+            for _ in 0..jobs {
+                s.spawn(worker);
+            }
+        });
+    }
+    let records = slots
+        .into_iter()
+        .map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()).expect("every slot is filled"))
+        .collect::<Result<Vec<_>>>()?;
+    Ok((records, todo.len()))
+}
+
+/// The run's status string (DESIGN.md): `ok` or `diverged: <cause at step/time>`.
+fn status(r: &RunRecord) -> String {
+    if r.summary.status == "ok" && r.summary.error.is_none() {
+        "ok".to_string()
+    } else {
+        format!("diverged: {}", r.summary.error.as_deref().unwrap_or("unknown cause"))
+    }
+}
+
+/// Builds a case's results from its run records: metrics, orders and checks.
+pub fn assemble(case: &Case, tier: Tier, records: &[RunRecord]) -> Result<CaseResults> {
+    let mut runs = Vec::with_capacity(records.len());
+    for r in records {
+        let probes = meniscus::ProbeRecord::from(r.probes.clone());
+        let measured = metrics::compute(&case.reference, &probes, r.summary.particles)
+            .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
+        runs.push(RunResult {
+            scheme: r.scheme.clone(),
+            preset: r.preset.clone(),
+            dx: r.dx,
+            particles: r.summary.particles,
+            steps: r.summary.steps,
+            wall_s: r.summary.wall_s,
+            status: status(r),
+            metrics: measured.metrics,
+            series: measured.series,
+        });
+    }
+    let convergence = convergence(case, &runs);
+    let checks = evaluate_all(&case.checks, &runs, tier);
+    Ok(CaseResults {
+        case: case.case.clone(),
+        scheme: case.scheme.clone(),
+        tier: tier.name().to_string(),
+        runs,
+        convergence,
+        checks,
+    })
+}
+
+/// Observed orders of the case's convergence metrics, from the runs that completed.
+pub fn convergence(case: &Case, runs: &[RunResult]) -> BTreeMap<String, Convergence> {
+    let primary = case.primary_preset();
+    let mut out = BTreeMap::new();
+    for metric in &case.convergence {
+        let mut by_preset = BTreeMap::new();
+        let mut primary_pts = None;
+        let mut presets: Vec<&str> = runs.iter().map(|r| r.preset.as_str()).collect();
+        presets.sort_unstable();
+        presets.dedup();
+        for preset in presets {
+            let mut pts: Vec<(f64, f64)> = runs
+                .iter()
+                .filter(|r| r.preset == preset && r.ok())
+                .filter_map(|r| r.metric(metric).map(|v| (r.dx, v)))
+                .collect();
+            pts.sort_by(|a, b| b.0.total_cmp(&a.0));
+            let (dx, e): (Vec<f64>, Vec<f64>) = pts.iter().copied().unzip();
+            if let Some(fit) = fit_power_law(&dx, &e) {
+                by_preset.insert(preset.to_string(), fit.order);
+                if preset == primary {
+                    primary_pts = Some((fit.order, dx, e));
+                }
+            }
+        }
+        if let Some((order, dx, values)) = primary_pts {
+            out.insert(
+                metric.clone(),
+                Convergence { order, preset: primary.to_string(), dx, values, by_preset },
+            );
+        }
+    }
+    out
+}
+
+/// Rebuilds `summary.json` from the results present in `out` (see [`report::render_all`]).
+pub fn summary_of(results: &[CaseResults]) -> Summary {
+    Summary::new(results.iter().map(crate::results::CaseSummary::of).collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::cache::CachedProbes;
+    use crate::io::testing::Scratch;
+
+    fn drop_case() -> Case {
+        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
+            .unwrap()
+    }
+
+    /// A synthetic record whose b error is `c dx^2` (a exact): no solver run.
+    fn synthetic(preset: &str, dx: f64, c: f64, particles: usize) -> RunRecord {
+        let t: Vec<f64> = (0..=4).map(|i| i as f64 * 2e-3).collect();
+        let exact = meniscus_reference::elliptical_drop::EllipticalDrop::new(1.0, 100.0, 1000.0)
+            .unwrap()
+            .states_at(&t)
+            .unwrap();
+        let axes: BTreeMap<String, Vec<f64>> = [
+            ("a_moment".to_string(), exact.iter().map(|s| s.a).collect()),
+            ("b_moment".to_string(), exact.iter().map(|s| s.b * (1.0 + c * dx * dx)).collect()),
+        ]
+        .into();
+        let e: BTreeMap<String, Vec<f64>> = [("e".to_string(), vec![1.0; t.len()])].into();
+        let p: BTreeMap<String, Vec<f64>> = [("p".to_string(), exact.iter().map(|s| s.pc).collect())].into();
+        let mut rec = crate::cache::tests::record("h");
+        rec.slug = crate::results::slug("isph", preset, dx);
+        rec.preset = preset.into();
+        rec.dx = dx;
+        rec.summary.particles = particles;
+        rec.probes = CachedProbes {
+            t,
+            series: [
+                ("ellipse_axes".to_string(), axes),
+                ("kinetic_energy".to_string(), e),
+                ("pressure_at".to_string(), p),
+            ]
+            .into(),
+        };
+        rec
+    }
+
+    #[test]
+    fn assemble_computes_orders_and_checks() {
+        let recs = vec![
+            synthetic("paper", 0.04, 5.0, 1976),
+            synthetic("tuned", 0.04, 1.0, 1976),
+            synthetic("paper", 0.02, 5.0, 7860),
+            synthetic("tuned", 0.02, 1.0, 7860),
+        ];
+        let res = assemble(&drop_case(), Tier::Quick, &recs).unwrap();
+        assert_eq!(res.tier, "quick");
+        assert_eq!(res.runs.len(), 4);
+        let conv = &res.convergence["b_rel_err_max"];
+        assert_eq!(conv.preset, "paper");
+        assert!((conv.order - 2.0).abs() < 1e-9, "{}", conv.order);
+        assert!((conv.by_preset["tuned"] - 2.0).abs() < 1e-9);
+        // a is exact: no positive errors, no order.
+        assert!(!res.convergence.contains_key("a_rel_err_max"));
+        let names: Vec<&str> = res.checks.iter().map(|c| c.name.as_str()).collect();
+        assert!(!names.iter().any(|n| n.contains("31428")), "dx=0.01 is not in the quick tier");
+        let b = res.checks.iter().find(|c| c.name.starts_with("b error (moments")).unwrap();
+        assert!(b.pass && (b.value.unwrap() - 5.0 * 0.02 * 0.02).abs() < 1e-12);
+        // a errors are exactly 0 at both spacings: 0 does not decrease (ratio undefined).
+        let a_dec = res.checks.iter().find(|c| c.name == "a error decreases with dx").unwrap();
+        assert!(!a_dec.pass);
+        assert!(res.checks.iter().find(|c| c.name == "b error decreases with dx").unwrap().pass);
+        assert!(res.checks.iter().filter(|c| c.name.contains("particles")).all(|c| c.pass));
+    }
+
+    #[test]
+    fn diverged_run_fails_its_checks() {
+        let mut bad = synthetic("paper", 0.02, 5.0, 7860);
+        bad.summary.status = "diverged".into();
+        bad.summary.error = Some("diverged in stage `ppe` at step 7".into());
+        let recs = vec![synthetic("paper", 0.04, 5.0, 1976), bad];
+        let res = assemble(&drop_case(), Tier::Quick, &recs).unwrap();
+        assert!(res.runs[1].status.starts_with("diverged: "));
+        let b = res.checks.iter().find(|c| c.name.starts_with("b error (moments")).unwrap();
+        assert!(!b.pass && b.note.as_deref().unwrap_or("").contains("diverged"));
+        assert!(!res.pass());
+        assert!(!res.convergence.contains_key("b_rel_err_max"), "diverged runs are not fitted");
+    }
+
+    /// A tiny real solver run (dx = 0.1, two steps) through the whole pipeline, twice:
+    /// the second invocation reuses the cache, a changed scene reruns.
+    #[test]
+    fn end_to_end_tiny_case_uses_the_cache() {
+        let dir = Scratch::new("validate");
+        let vdir = dir.path().join("validation");
+        let mut case = drop_case();
+        case.case = "tiny_drop".into();
+        case.scene["time"]["end"] = serde_json::json!(0.0004);
+        case.scene["output"]["probe_every"] = serde_json::json!(5);
+        case.sweep.dx = [(Tier::Quick, vec![0.1])].into();
+        case.sweep.presets.truncate(1);
+        io::write_json(&vdir.join("tiny_drop.json"), &case).unwrap();
+        let opts = ValidateOptions {
+            tier: Tier::Quick,
+            cases: vec![],
+            out: dir.path().join("reports"),
+            validation_dir: vdir.clone(),
+            workspace: dir.path().to_path_buf(),
+            force: false,
+            jobs: 1,
+            progress: false,
+        };
+        let first = validate(&opts).unwrap();
+        assert_eq!((first.executed, first.reused), (1, 0));
+        let res = &first.results[0];
+        assert_eq!(res.runs[0].status, "ok");
+        assert!(res.runs[0].metrics["b_rel_err_max"].is_finite());
+        assert!(opts.out.join("tiny_drop/runs/isph-paper_dx0.1.json").is_file());
+        assert!(opts.out.join("tiny_drop/index.html").is_file());
+        assert!(opts.out.join("summary.json").is_file());
+        assert!(opts.out.join("index.html").is_file());
+        let second = validate(&opts).unwrap();
+        assert_eq!((second.executed, second.reused), (0, 1));
+        assert_eq!(second.results[0].runs, first.results[0].runs);
+        case.scene["time"]["end"] = serde_json::json!(0.0006);
+        io::write_json(&vdir.join("tiny_drop.json"), &case).unwrap();
+        let third = validate(&opts).unwrap();
+        assert_eq!((third.executed, third.reused), (1, 0), "scene hash changed: rerun");
+        let forced = validate(&ValidateOptions { force: true, ..opts.clone() }).unwrap();
+        assert_eq!(forced.executed, 1);
+    }
+}

@@ -1,0 +1,49 @@
+//! Project tasks: `cargo xtask validate | report` (DESIGN.md "Command lines").
+//!
+//! Thin by design: parsing and dispatch only; the logic lives in `meniscus-harness`.
+
+mod report;
+mod validate;
+
+use clap::{Parser, Subcommand};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Meniscus project tasks.
+#[derive(Debug, Parser)]
+#[command(name = "cargo xtask", bin_name = "cargo xtask")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+/// One subcommand per module.
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Run the validation cases, write reports/<case>/results.json, summary.json and the
+    /// HTML report; exit code 0 only when every check passes.
+    Validate(validate::Args),
+    /// Re-render the HTML report and summary.json from the existing results files (no runs).
+    Report(report::Args),
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::Validate(args) => validate::run(args),
+        Command::Report(args) => report::run(args),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+/// The workspace root (the parent of this package's directory).
+fn workspace_root() -> PathBuf {
+    let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
+    manifest.parent().map(PathBuf::from).unwrap_or(manifest)
+}

@@ -1,0 +1,75 @@
+//! `cargo xtask validate [--quick|--full] [--case NAME…] [--out DIR] [--force] [--jobs N]`.
+
+use anyhow::Context;
+use meniscus_harness::{Tier, ValidateOptions};
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Options of `cargo xtask validate`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The CI tier (coarse spacings, under 10 minutes).
+    #[arg(long, conflicts_with = "full")]
+    quick: bool,
+    /// The extended sweeps (finer spacings, long runs).
+    #[arg(long)]
+    full: bool,
+    /// Run only this case (repeatable); all of validation/*.json by default.
+    #[arg(long = "case", value_name = "NAME")]
+    cases: Vec<String>,
+    /// Output directory [default: <workspace>/reports].
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Rerun every run even when a valid cached result exists.
+    #[arg(long)]
+    force: bool,
+    /// Runs executed concurrently.
+    #[arg(long, value_name = "N", default_value_t = 1)]
+    jobs: usize,
+    /// No progress bars.
+    #[arg(long)]
+    no_progress: bool,
+}
+
+/// Runs the validation; the exit code is 0 only when every check passes.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let root = crate::workspace_root();
+    let tier = if args.quick {
+        Tier::Quick
+    } else if args.full {
+        Tier::Full
+    } else {
+        Tier::Default
+    };
+    let opts = ValidateOptions {
+        tier,
+        cases: args.cases,
+        out: args.out.unwrap_or_else(|| root.join("reports")),
+        validation_dir: root.join("validation"),
+        workspace: root.clone(),
+        force: args.force,
+        jobs: args.jobs.max(1),
+        progress: !args.no_progress,
+    };
+    let start = Instant::now();
+    let outcome = meniscus_harness::validate(&opts).context("validation could not run")?;
+    for r in &outcome.results {
+        let (passed, failed) = r.counts();
+        eprintln!("{:<24} {:>3} passed {:>3} failed", r.case, passed, failed);
+        for c in r.checks.iter().filter(|c| !c.pass) {
+            let value = c.value.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
+            let threshold = c.threshold.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
+            let note = c.note.as_deref().map(|n| format!(" [{n}]")).unwrap_or_default();
+            eprintln!("  FAIL {}: {value} (threshold {threshold}){note}", c.name);
+        }
+    }
+    eprintln!(
+        "{} runs executed, {} cached, {:.1} s; report: {}",
+        outcome.executed,
+        outcome.reused,
+        start.elapsed().as_secs_f64(),
+        opts.out.join("index.html").display()
+    );
+    Ok(if outcome.pass() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+}
