@@ -116,9 +116,11 @@ mod tests {
             ["isph-paper_dx0.04", "isph-tuned_dx0.04", "isph-paper_dx0.02", "isph-tuned_dx0.02"]
         );
         assert!((runs[2].scene.dx - 0.02).abs() < 1e-15);
-        assert_eq!(runs[1].scene_json["scheme"]["isph"]["ppe"]["solver"], "cg");
-        assert_eq!(runs[1].scene_json["scheme"]["isph"]["pressure_gradient"], "difference");
-        assert_eq!(runs[0].scene_json["scheme"]["isph"]["ppe"]["solver"], "bicgstab");
+        // The tuned preset's merge patch replaces Xu shifting by Fickian shifting.
+        assert_eq!(runs[1].scene_json["scheme"]["isph"]["divergence"], "corrected");
+        assert!(runs[1].scene_json["scheme"]["isph"]["shifting"].get("xu").is_none());
+        assert_eq!(runs[1].scene_json["scheme"]["isph"]["shifting"]["fickian"]["coefficient"], 2.0);
+        assert!(runs[0].scene_json["scheme"]["isph"]["shifting"].get("xu").is_some());
         assert_eq!(runs[0].hash.len(), 64);
         assert_ne!(runs[0].hash, runs[1].hash);
         assert_ne!(runs[0].hash, runs[2].hash);

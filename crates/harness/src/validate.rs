@@ -297,9 +297,9 @@ mod tests {
         let b = res.checks.iter().find(|c| c.name.starts_with("b error (moments")).unwrap();
         assert!(b.pass && (b.value.unwrap() - 5.0 * 0.02 * 0.02).abs() < 1e-12);
         // a errors are exactly 0 at both spacings: 0 does not decrease (ratio undefined).
-        let a_dec = res.checks.iter().find(|c| c.name == "a error decreases with dx").unwrap();
+        let a_dec = res.checks.iter().find(|c| c.name == "a error decreases with dx (paper)").unwrap();
         assert!(!a_dec.pass);
-        assert!(res.checks.iter().find(|c| c.name == "b error decreases with dx").unwrap().pass);
+        assert!(res.checks.iter().find(|c| c.name == "b error decreases with dx (paper)").unwrap().pass);
         assert!(res.checks.iter().filter(|c| c.name.contains("particles")).all(|c| c.pass));
     }
 
