@@ -55,8 +55,8 @@ pub struct Frame {
     pub free_surface: Vec<bool>,
 }
 
-/// Receives progress and frames while a run goes on.
-pub trait Observer {
+/// Receives progress and frames while a run goes on (on a worker thread of the rayon pool).
+pub trait Observer: Send {
     /// Called after every step.
     fn progress(&mut self, _step: usize, _time: f64, _t_end: f64) {}
     /// Called with a frame every `output.vtk_every` steps (and at step 0).
@@ -223,7 +223,19 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// Runs to the end time.
+    ///
+    /// The step loop runs on a worker thread of the current rayon pool, so the parallel
+    /// loops of the stages start without a hand-over from an outside thread (measured:
+    /// 12 % of a single-thread run went to futex waits before).
     pub fn run(&mut self, observer: &mut dyn Observer) -> RunReport {
+        if rayon::current_thread_index().is_some() {
+            self.run_on_worker(observer)
+        } else {
+            rayon::scope(|_| self.run_on_worker(observer))
+        }
+    }
+
+    fn run_on_worker(&mut self, observer: &mut dyn Observer) -> RunReport {
         let threads = rayon::current_num_threads();
         let t_end = self.scene.time.end;
         let mut timings = vec![0.0; self.stages.len()];
