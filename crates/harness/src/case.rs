@@ -100,6 +100,11 @@ pub struct Sweep {
     pub dx: BTreeMap<Tier, Vec<f64>>,
     /// Option sets; every preset runs at every spacing of the tier (unless it names tiers).
     pub presets: Vec<Preset>,
+    /// For spacings finer than the template's, scale a fixed Δt by `dx / dx_template`, so the
+    /// CFL number `u_max Δt / h` never exceeds the template's (coarser spacings keep the
+    /// template's Δt).
+    #[serde(default)]
+    pub scale_dt_with_dx: bool,
 }
 
 /// A named option set: a JSON merge patch on the scene template.

@@ -26,7 +26,8 @@ pub struct RunSpec {
     pub hash: String,
 }
 
-/// The effective scene JSON of `preset` at spacing `dx`: template, merge patch, `dx`.
+/// The effective scene JSON of `preset` at spacing `dx`: template, merge patch, `dx`, and
+/// the fixed Δt scaled down with `dx` when the sweep asks for it.
 pub fn effective_scene(case: &Case, preset: &str, dx: f64) -> Result<serde_json::Value> {
     let p = case
         .sweep
@@ -36,7 +37,14 @@ pub fn effective_scene(case: &Case, preset: &str, dx: f64) -> Result<serde_json:
         .ok_or_else(|| HarnessError::case(&case.case, format!("no preset `{preset}`")))?;
     let mut scene = case.scene.clone();
     merge_patch(&mut scene, &p.patch);
+    let template_dx = scene["dx"].as_f64();
     scene["dx"] = serde_json::json!(dx);
+    if case.sweep.scale_dt_with_dx
+        && let (Some(dx0), Some(dt0)) = (template_dx, scene["time"]["step"]["fixed"].as_f64())
+        && dx < dx0
+    {
+        scene["time"]["step"]["fixed"] = serde_json::json!(dt0 * dx / dx0);
+    }
     Ok(scene)
 }
 
@@ -124,7 +132,13 @@ mod tests {
         assert_eq!(runs[0].hash.len(), 64);
         assert_ne!(runs[0].hash, runs[1].hash);
         assert_ne!(runs[0].hash, runs[2].hash);
-        assert_eq!(expand(&case(), Tier::Full).unwrap().len(), 8);
+        let full = expand(&case(), Tier::Full).unwrap();
+        assert_eq!(full.len(), 8);
+        // Δt scales with dx below the template's 0.02 (CFL number kept), not above it.
+        let dt = |r: &RunSpec| r.scene_json["time"]["step"]["fixed"].as_f64().unwrap();
+        assert!((dt(&full[0]) - 2e-5).abs() < 1e-18, "dx = 0.04 keeps the paper's dt");
+        assert!((dt(&full[2]) - 2e-5).abs() < 1e-18);
+        assert!((dt(&full[6]) - 5e-6).abs() < 1e-18, "dx = 0.005: {}", dt(&full[6]));
     }
 
     #[test]

@@ -16,7 +16,8 @@
 //! Velocity (Xu 2009; Qiu §2.6): `u_a ← u_a + (∇u)_a δr_a` with the kernel-gradient
 //! corrected velocity gradient `∇u_a = G_a M_a⁻¹`, `G_a = Σ_b V_b (u_b − u_a) ⊗ ∇_aW_ab`,
 //! `M_a = Σ_b V_b (r_b − r_a) ⊗ ∇_aW_ab` (Bonet & Lok 1999), which stays first-order
-//! accurate near the surface where the kernel support is truncated.
+//! accurate near the surface where the kernel support is truncated (where `M` is near
+//! singular, with few neighbours, the uncorrected `G` is used).
 
 use crate::error::Cause;
 use crate::kernel::{Kernel, Scaled};
@@ -34,7 +35,10 @@ pub enum Law {
     Fickian(f64),
 }
 
-/// The shifting stage, evaluated at the updated positions `r^{n+1}`.
+/// The shifting stage. It runs after the position update and reuses the step's pair
+/// geometry from r*: the particles have moved by `Δt (uⁿ⁺¹ − uⁿ)/2` since, about 1e-5 Δx
+/// in the drop, far below what the shift's heuristic resolves; recomputing the geometry
+/// made the stage 2.7 times slower (2.52 against 0.93 ms per step, drop at Δx = 0.02).
 #[derive(Debug)]
 pub struct Shifting<K: Kernel, const D: usize> {
     law: Law,
@@ -63,9 +67,9 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
         self.du.resize(n, Vector::zeros());
         let u_max = s.max_speed();
         let (k, law, dt, v, dom) = (self.kernel, self.law, ctx.dt, s.volume, s.domain);
-        let (x, u, list) = (&s.particles.x, &s.particles.u, &s.neighbours);
+        let (u, list, pairs) = (&s.particles.u, &s.neighbours, &s.pairs);
         let (div_r, threshold) = (&s.div_r, self.threshold);
-        let support2 = k.support * k.support;
+        let xu = matches!(law, Law::Xu(_));
         self.shift.par_iter_mut().zip(self.du.par_iter_mut()).enumerate().with_min_len(128).for_each(
             |(a, (shift, du))| {
                 let mut grad_c = Vector::<D>::zeros();
@@ -74,22 +78,22 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
                 let mut xu_sum = Vector::<D>::zeros();
                 let mut r_sum = 0.0;
                 let mut count = 0usize;
-                for &b in list.of(a) {
-                    let b = b as usize;
-                    let r_ab = dom.displacement(&x[a], &x[b]);
-                    let r2 = r_ab.norm_squared();
-                    if r2 >= support2 || r2 == 0.0 {
+                let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
+                for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+                    if p.r2 == 0.0 {
                         continue;
                     }
-                    let r = r2.sqrt();
-                    let grad = r_ab * (v * k.grad_factor(r));
+                    let grad = p.r_ab * (v * p.f);
                     grad_c += grad;
-                    g += (u[b] - u[a]) * grad.transpose();
-                    m -= r_ab * grad.transpose();
-                    // n_ab / r_ab² (r̄² applied after the loop).
-                    xu_sum += r_ab / (r2 * r);
-                    r_sum += r;
-                    count += 1;
+                    g += (u[b as usize] - u[a]) * grad.transpose();
+                    m -= p.r_ab * grad.transpose();
+                    if xu {
+                        // n_ab / r_ab² (r̄² applied after the loop).
+                        let r = p.r2.sqrt();
+                        xu_sum += p.r_ab / (p.r2 * r);
+                        r_sum += r;
+                        count += 1;
+                    }
                 }
                 let mut d = match law {
                     Law::Xu(c) if count > 0 => {
@@ -102,10 +106,10 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
                 // Near the surface: scale by (div r − t)/(D − t) in [0, 1]; surface particles
                 // (div r < t) are not shifted.
                 d *= ((div_r[a] - threshold) / (D as f64 - threshold)).clamp(0.0, 1.0);
-                // M ≈ −I in the bulk; fall back to G where M is near singular (few neighbours).
-                let grad_u = match (-m).try_inverse() {
-                    Some(mi) if mi.norm() < 10.0 => -(g * mi),
-                    _ => -g,
+                // M ≈ I in the bulk; fall back to G where M is near singular (few neighbours).
+                let grad_u = match m.try_inverse() {
+                    Some(mi) if mi.norm() < 10.0 => g * mi,
+                    _ => g,
                 };
                 *shift = d;
                 *du = grad_u * d;
