@@ -1,6 +1,7 @@
 //! The run cache: every finished run is stored at `reports/<case>/runs/<slug>.json`
-//! (atomically, with `"completed": true` and the SHA-256 of its effective scene), and
-//! reused by the next invocation unless `--force` or the scene changed. Metrics are
+//! (atomically, with `"completed": true` and the SHA-256 of its effective scene and of the
+//! solver build), and reused by the next invocation unless `--force`, the scene changed or
+//! the solver was rebuilt from changed code. Metrics are
 //! recomputed from the cached probes each time, so changing a metric never needs a rerun.
 
 use crate::error::Result;
@@ -22,7 +23,7 @@ pub struct RunRecord {
     pub preset: String,
     /// Spacing \[m\].
     pub dx: f64,
-    /// SHA-256 (hex) of the effective scene JSON.
+    /// SHA-256 (hex) of the solver build fingerprint and the effective scene JSON.
     pub scene_hash: String,
     /// The effective scene.
     pub scene: serde_json::Value,

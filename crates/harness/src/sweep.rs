@@ -22,7 +22,8 @@ pub struct RunSpec {
     /// The effective scene as JSON (canonical: the typed scene re-serialised, defaults
     /// included), which is what `hash` covers.
     pub scene_json: serde_json::Value,
-    /// SHA-256 of the canonical scene JSON.
+    /// SHA-256 of the build fingerprint and the canonical scene JSON: a cached run is
+    /// reused only for the same scene computed by the same build of the solver.
     pub hash: String,
 }
 
@@ -63,8 +64,24 @@ pub fn spec(case: &Case, preset: &str, dx: f64) -> Result<RunSpec> {
     })?;
     let canonical = serde_json::to_value(&scene)
         .map_err(|e| HarnessError::case(&case.case, format!("run {slug}: scene does not serialise: {e}")))?;
-    let hash = sha256_hex(&canonical.to_string());
+    let hash = sha256_hex(&format!("{}\n{canonical}", build_fingerprint()));
     Ok(RunSpec { scheme, preset: preset.to_string(), dx, slug, scene, scene_json: canonical, hash })
+}
+
+/// SHA-256 of the running executable (which contains the solver), computed once: any
+/// change of the solver's code gives a new build and so invalidates cached runs. Falls back
+/// to the harness version when the executable cannot be read.
+pub fn build_fingerprint() -> &'static str {
+    static FINGERPRINT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
+    FINGERPRINT.get_or_init(|| {
+        std::env::current_exe()
+            .and_then(std::fs::read)
+            .map(|bytes| {
+                use sha2::{Digest, Sha256};
+                Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect()
+            })
+            .unwrap_or_else(|_| format!("meniscus-harness {}", env!("CARGO_PKG_VERSION")))
+    })
 }
 
 /// Every run of `case` in `tier`: spacings from coarse to fine, presets in file order.
