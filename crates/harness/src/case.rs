@@ -188,6 +188,17 @@ pub enum Figure {
         /// The error metric on the x axis.
         metric: String,
     },
+    /// Relative error against time, `|series / reference − 1|` on a log axis: one figure
+    /// per preset, one colour per resolution, one dash style per pair.
+    ErrorHistory {
+        /// File stem (`<file>_<preset>.svg`).
+        file: String,
+        /// Title.
+        #[serde(default)]
+        title: String,
+        /// (run series, reference series) pairs, e.g. `["b_moment", "b_ref"]`.
+        pairs: Vec<[String; 2]>,
+    },
 }
 
 impl Case {

@@ -50,6 +50,17 @@ pub fn render_case(
                     figures.push(FigureFile { file: name, caption });
                 }
             }
+            Figure::ErrorHistory { file, title, pairs } => {
+                for p in &presets {
+                    let mut mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p).collect();
+                    mine.sort_by(|a, b| b.dx.total_cmp(&a.dx));
+                    let name = format!("{file}_{p}.svg");
+                    let caption = format!("{title} — preset {p}");
+                    let svg = plots::error_history(&name, &caption, &mine, pairs)?;
+                    io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
+                    figures.push(FigureFile { file: name, caption });
+                }
+            }
             Figure::Convergence { file, title, metrics, slope } => {
                 let name = format!("{file}.svg");
                 let svg = plots::convergence(&name, title, &runs, metrics, *slope)?;

@@ -146,6 +146,68 @@ pub fn history(
     .map_err(plot_err(file))
 }
 
+/// Relative errors `|s / ref − 1|` against time on a log axis: one colour per run, solid
+/// for the first pair and dashed for the others. Samples where the error is zero or not
+/// finite are left out (a log axis cannot show them).
+pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[String; 2]]) -> Result<String> {
+    /// (run index, pair index, points).
+    type Curve = (usize, usize, Vec<(f64, f64)>);
+    let curves: Vec<Curve> = runs
+        .iter()
+        .enumerate()
+        .flat_map(|(i, r)| {
+            let t = r.series.get("t").cloned().unwrap_or_default();
+            pairs.iter().enumerate().filter_map(move |(j, [s, reference])| {
+                let (v, e) = (r.series.get(s)?, r.series.get(reference)?);
+                let pts = t
+                    .iter()
+                    .zip(v.iter().zip(e))
+                    .map(|(t, (v, e))| (*t, (v / e - 1.0).abs()))
+                    .filter(|(t, y)| t.is_finite() && y.is_finite() && *y > 0.0)
+                    .collect();
+                Some((i, j, pts))
+            })
+        })
+        .collect();
+    let (t0, t1) = range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.0)), 0.0);
+    let (y0, y1) = log_range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.1)), 1.5);
+    svg(|root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(title, ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(70)
+            .build_cartesian_2d(t0..t1, (y0..y1).log_scale())
+            .map_err(boxed)?;
+        chart.configure_mesh().x_desc("t [s]").y_desc("relative error").draw().map_err(boxed)?;
+        for (i, j, pts) in curves {
+            let (r, c) = (runs[i], colour(i));
+            let [s, reference] = &pairs[j];
+            let label = format!("{s} vs {reference}, dx={}{}", r.dx, if r.ok() { "" } else { " (diverged)" });
+            let width = if j == 0 { 2 } else { 1 };
+            let series = if j == 0 {
+                chart.draw_series(LineSeries::new(pts, c.stroke_width(width))).map_err(boxed)?
+            } else {
+                chart
+                    .draw_series(DashedLineSeries::new(pts, 2 + 3 * j as u32, 4, c.stroke_width(width)))
+                    .map_err(boxed)?
+            };
+            series
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(width)));
+        }
+        chart
+            .configure_series_labels()
+            .position(SeriesLabelPosition::LowerRight)
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .draw()
+            .map_err(boxed)?;
+        Ok(())
+    })
+    .map_err(plot_err(file))
+}
+
 /// Error against dx in log-log: one line per metric and preset, labelled with the fitted
 /// order, and a reference line of slope `slope` through the finest point of the first.
 pub fn convergence(
