@@ -336,8 +336,8 @@ impl<const D: usize> Simulation<D> {
                 dt
             }
         };
-        // Avoid a sliver of a last step: stretch the previous one instead.
-        Ok(if remaining < 1.5 * dt && remaining > dt { remaining } else { dt.min(remaining) })
+        // Never more than Δt; a remainder within rounding of Δt is taken whole.
+        Ok(if remaining <= dt * (1.0 + 1e-9) { remaining } else { dt })
     }
 
     /// End-of-step checks: finite values, no particle escaped.

@@ -40,3 +40,15 @@ fn adaptive_time_step_respects_qiu_limits_and_reaches_the_end() {
     let b = report.probes.get("ellipse_axes", "b_moment").expect("probe");
     assert!((b[b.len() - 1] - 1.9993).abs() < 0.04, "b = {}", b[b.len() - 1]);
 }
+
+#[test]
+fn a_fractional_last_step_is_shorter_never_longer() {
+    let scene = common::drop_scene(|v| {
+        v["dx"] = json!(0.04);
+        v["time"] = json!({"end": 5e-5, "step": {"fixed": 2e-5}});
+    });
+    let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
+    assert!(report.error.is_none());
+    assert_eq!(report.summary.steps, 3);
+    assert!((report.summary.t_end - 5e-5).abs() < 1e-18);
+}
