@@ -101,6 +101,9 @@ pub struct CellSearch<const D: usize> {
     counts: Vec<u32>,
 }
 
+/// Cap on the cell grid: at most this many cells per particle.
+const MAX_CELLS_PER_PARTICLE: usize = 8;
+
 /// Rows per parallel task when filling the lists.
 const CHUNK: usize = 512;
 
@@ -135,17 +138,31 @@ impl<const D: usize> CellSearch<D> {
             lo = lo.inf(p);
             hi = hi.sup(p);
         }
+        // Cells of at least the search radius; larger when the particles are spread so far
+        // (a run blowing up) that the grid would exceed MAX_CELLS_PER_PARTICLE cells per
+        // particle: the search stays correct, only slower, until the guard stops the run.
+        let extent: f64 = (0..D)
+            .map(|k| match self.domain.periodic[k] {
+                Some((a, b)) => (b - a) / self.radius,
+                None => (hi[k] - lo[k]) / self.radius + 1.0,
+            })
+            .map(|c| if c.is_finite() { c.max(1.0) } else { 1.0 })
+            .product();
+        let limit = (MAX_CELLS_PER_PARTICLE * x.len().max(1)) as f64;
+        let scale = if extent > limit { (extent / limit).powf(1.0 / D as f64) } else { 1.0 };
+        let size = self.radius * scale;
         for k in 0..D {
             if let Some((a, b)) = self.domain.periodic[k] {
-                // Whole number of cells per period, each at least the radius.
-                let cells = ((b - a) / self.radius).floor().max(1.0) as usize;
+                // Whole number of cells per period, each at least `size`.
+                let cells = ((b - a) / size).floor().max(1.0) as usize;
                 self.dims[k] = cells;
                 self.origin[k] = a;
                 self.cell_size[k] = (b - a) / cells as f64;
             } else {
-                self.origin[k] = lo[k];
-                self.cell_size[k] = self.radius;
-                self.dims[k] = (((hi[k] - lo[k]) / self.radius).floor() as usize + 1).max(1);
+                let span = if (hi[k] - lo[k]).is_finite() { hi[k] - lo[k] } else { 0.0 };
+                self.origin[k] = if lo[k].is_finite() { lo[k] } else { 0.0 };
+                self.cell_size[k] = size;
+                self.dims[k] = ((span / size).floor() as usize + 1).max(1);
             }
         }
         let ncells: usize = self.dims.iter().product();
@@ -324,6 +341,30 @@ mod tests {
         check::<3>(500, 0.2, per3, 8);
         // Fewer than three cells per period.
         check::<2>(200, 0.45, per, 9);
+    }
+
+    #[test]
+    fn far_flung_particles_do_not_explode_the_grid() {
+        // A blown-up particle far away: the grid is coarsened, the pairs stay right.
+        let mut rng = ChaCha8Rng::seed_from_u64(5);
+        let mut x: Vec<SVector<f64, 2>> =
+            (0..400).map(|_| SVector::from_fn(|_, _| rng.random_range(0.0..1.0))).collect();
+        x.push(SVector::<f64, 2>::from([1e12, -1e12]));
+        let mut search = CellSearch::new(0.08, Domain::default());
+        let mut list = NeighbourList::default();
+        search.build(&x, &mut list);
+        let want = brute(&x, 0.08, &Domain::default());
+        for (a, want) in want.iter().enumerate() {
+            let mut got = list.of(a).to_vec();
+            got.sort_unstable();
+            assert_eq!(&got, want);
+        }
+        // At most MAX_CELLS_PER_PARTICLE cells per particle, plus one layer per axis.
+        assert!(
+            search.cell_start.len() <= 2 * MAX_CELLS_PER_PARTICLE * x.len(),
+            "{}",
+            search.cell_start.len()
+        );
     }
 
     #[test]

@@ -179,6 +179,9 @@ impl<const D: usize> Simulation<D> {
         for axis in &scene.boundaries.periodic {
             domain.periodic[axis.axis] = Some((axis.min, axis.max));
         }
+        for x in &mut particles.x {
+            domain.wrap(x);
+        }
         let mut lo = Vector::<D>::repeat(f64::INFINITY);
         let mut hi = Vector::<D>::repeat(f64::NEG_INFINITY);
         for x in &particles.x {

@@ -53,6 +53,8 @@ fn each_invalid_field_is_named() {
             Box::new(|v| v["scheme"]["isph"]["shifting"]["xu"]["coefficient"] = json!(-0.02)),
         ),
         ("output.probe_every", Box::new(|v| v["output"]["probe_every"] = json!(0))),
+        ("dx", Box::new(|v| v["dx"] = json!(1e-5))),
+        ("kernel.h_over_dx", Box::new(|v| v["kernel"]["h_over_dx"] = json!(0.5))),
         ("fluid", Box::new(|v| v["fluid"]["colour"] = json!(1))),
         ("unknown_top_level", Box::new(|v| v["unknown_top_level"] = json!(1))),
     ];

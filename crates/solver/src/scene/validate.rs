@@ -14,6 +14,13 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     }
     positive("dx", scene.dx)?;
     positive("kernel.h_over_dx", scene.kernel.h_over_dx)?;
+    if scene.kernel.h_over_dx < 1.0 {
+        return Err(SceneError::new(
+            "kernel.h_over_dx",
+            scene.kernel.h_over_dx,
+            "must be at least 1 (the kernel support must reach the nearest neighbours)",
+        ));
+    }
     if scene.kernel.h_over_dx > 4.0 {
         return Err(SceneError::new(
             "kernel.h_over_dx",
@@ -32,6 +39,14 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     }
     for (i, body) in scene.bodies.iter().enumerate() {
         validate_body(&format!("bodies[{i}]"), body, d, scene.dx)?;
+    }
+    let estimate: f64 = scene.bodies.iter().map(|b| shape_measure(&b.shape) / scene.dx.powi(d as i32)).sum();
+    if estimate > MAX_PARTICLES {
+        return Err(SceneError::new(
+            "dx",
+            scene.dx,
+            format!("gives about {estimate:.3e} particles; at most {MAX_PARTICLES:.0e} are supported"),
+        ));
     }
     for (i, axis) in scene.boundaries.periodic.iter().enumerate() {
         let f = format!("boundaries.periodic[{i}]");
@@ -86,6 +101,20 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         return Err(SceneError::new("output.probe_every", 0, "must be at least 1"));
     }
     Ok(())
+}
+
+/// Largest particle count a scene may ask for (memory: about 1 kB per particle).
+const MAX_PARTICLES: f64 = 5e7;
+
+/// Area (2D) or volume (3D) of a validated shape \[m^D\].
+fn shape_measure(shape: &Shape) -> f64 {
+    match shape {
+        Shape::Circle { radius, .. } => std::f64::consts::PI * radius * radius,
+        Shape::Sphere { radius, .. } => 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3),
+        Shape::Rectangle { min, max } | Shape::Box { min, max } => {
+            min.iter().zip(max).map(|(a, b)| (b - a).max(0.0)).product()
+        }
+    }
 }
 
 fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
