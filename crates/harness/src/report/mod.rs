@@ -40,26 +40,14 @@ pub fn render_case(
     for fig in record.map(|r| r.case.figures.as_slice()).unwrap_or(&[]) {
         match fig {
             Figure::History { file, title, y_label, series, reference } => {
-                for p in &presets {
-                    let mut mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p).collect();
-                    mine.sort_by(|a, b| b.dx.total_cmp(&a.dx));
-                    let name = format!("{file}_{p}.svg");
-                    let caption = format!("{title} — preset {p}");
-                    let svg = plots::history(&name, &caption, y_label, &mine, series, reference.as_deref())?;
-                    io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
-                    figures.push(FigureFile { file: name, caption });
-                }
+                per_preset(case_dir, &runs, &presets, file, title, &mut figures, |name, caption, mine| {
+                    plots::history(name, caption, y_label, mine, series, reference.as_deref())
+                })?;
             }
             Figure::ErrorHistory { file, title, pairs } => {
-                for p in &presets {
-                    let mut mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p).collect();
-                    mine.sort_by(|a, b| b.dx.total_cmp(&a.dx));
-                    let name = format!("{file}_{p}.svg");
-                    let caption = format!("{title} — preset {p}");
-                    let svg = plots::error_history(&name, &caption, &mine, pairs)?;
-                    io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
-                    figures.push(FigureFile { file: name, caption });
-                }
+                per_preset(case_dir, &runs, &presets, file, title, &mut figures, |name, caption, mine| {
+                    plots::error_history(name, caption, mine, pairs)
+                })?;
             }
             Figure::Convergence { file, title, metrics, slope } => {
                 let name = format!("{file}.svg");
@@ -78,6 +66,28 @@ pub fn render_case(
     let page = html::case_page(results, record, &figures);
     io::write_atomic(&case_dir.join("index.html"), page.as_bytes())?;
     Ok(figures)
+}
+
+/// Draws one figure per preset (`<file>_<preset>.svg`, runs coarse to fine) with `draw`.
+fn per_preset(
+    case_dir: &Path,
+    runs: &[&RunResult],
+    presets: &[&str],
+    file: &str,
+    title: &str,
+    figures: &mut Vec<FigureFile>,
+    draw: impl Fn(&str, &str, &[&RunResult]) -> Result<String>,
+) -> Result<()> {
+    for p in presets {
+        let mut mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p).collect();
+        mine.sort_by(|a, b| b.dx.total_cmp(&a.dx));
+        let name = format!("{file}_{p}.svg");
+        let caption = format!("{title} — preset {p}");
+        let svg = draw(&name, &caption, &mine)?;
+        io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
+        figures.push(FigureFile { file: name, caption });
+    }
+    Ok(())
 }
 
 /// Every `<out>/<case>/results.json` present, sorted by case name.

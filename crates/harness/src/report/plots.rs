@@ -67,6 +67,30 @@ fn svg(
     Ok(out)
 }
 
+/// A chart builder with the report's caption font, margin and label areas.
+fn builder<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, Shift>,
+    title: &str,
+) -> ChartBuilder<'a, 'b, SVGBackend<'b>> {
+    let mut b = ChartBuilder::on(root);
+    b.caption(title, ("sans-serif", 18)).margin(12).x_label_area_size(40).y_label_area_size(70);
+    b
+}
+
+/// Draws the series legend at `position` on a translucent white box.
+fn legend<'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, CT>,
+    position: SeriesLabelPosition,
+) -> std::result::Result<(), Box<dyn std::fmt::Debug>> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(boxed)
+}
+
 fn boxed<E: std::fmt::Debug + 'static>(e: E) -> Box<dyn std::fmt::Debug> {
     Box::new(e)
 }
@@ -94,13 +118,7 @@ pub fn history(
     let (y0, y1) = range(all_y.into_iter(), 0.05);
     let finest = runs.iter().filter(|r| r.ok()).min_by(|a, b| a.dx.total_cmp(&b.dx)).or(runs.first());
     svg(|root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
-            .build_cartesian_2d(t0..t1, y0..y1)
-            .map_err(boxed)?;
+        let mut chart = builder(root, title).build_cartesian_2d(t0..t1, y0..y1).map_err(boxed)?;
         chart.configure_mesh().x_desc("t [s]").y_desc(y_label).draw().map_err(boxed)?;
         if let (Some(r), Some(name)) = (finest, reference)
             && let Some(v) = r.series.get(name)
@@ -134,13 +152,7 @@ pub fn history(
                 }
             }
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperLeft)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(boxed)?;
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)?;
         Ok(())
     })
     .map_err(plot_err(file))
@@ -172,13 +184,8 @@ pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[Str
     let (t0, t1) = range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.0)), 0.0);
     let (y0, y1) = log_range(curves.iter().flat_map(|c| c.2.iter().map(|p| p.1)), 1.5);
     svg(|root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
-            .build_cartesian_2d(t0..t1, (y0..y1).log_scale())
-            .map_err(boxed)?;
+        let mut chart =
+            builder(root, title).build_cartesian_2d(t0..t1, (y0..y1).log_scale()).map_err(boxed)?;
         chart.configure_mesh().x_desc("t [s]").y_desc("relative error").draw().map_err(boxed)?;
         for (i, j, pts) in curves {
             let (r, c) = (runs[i], colour(i));
@@ -196,13 +203,7 @@ pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[Str
                 .label(label)
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(width)));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(boxed)?;
+        legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         Ok(())
     })
     .map_err(plot_err(file))
@@ -243,11 +244,7 @@ pub fn convergence(
     let (x0, x1) = log_range(lines.iter().flat_map(|l| l.3.iter().map(|p| p.0)), 1.3);
     let (y0, y1) = log_range(lines.iter().flat_map(|l| l.3.iter().map(|p| p.1)), 2.0);
     svg(|root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
+        let mut chart = builder(root, title)
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(boxed)?;
         chart
@@ -287,13 +284,7 @@ pub fn convergence(
                 .label(format!("reference slope dx^{s}"))
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 8, y)], grey));
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::LowerRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(boxed)?;
+        legend(&mut chart, SeriesLabelPosition::LowerRight)?;
         Ok(())
     })
     .map_err(plot_err(file))
@@ -313,11 +304,7 @@ pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Resul
     let (x0, x1) = log_range(pts.iter().map(|p| p.2), 2.0);
     let (y0, y1) = log_range(pts.iter().map(|p| p.3), 2.0);
     svg(|root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(title, ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(40)
-            .y_label_area_size(70)
+        let mut chart = builder(root, title)
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(boxed)?;
         chart
@@ -341,13 +328,7 @@ pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Resul
                 )
                 .map_err(boxed)?;
         }
-        chart
-            .configure_series_labels()
-            .position(SeriesLabelPosition::UpperRight)
-            .background_style(WHITE.mix(0.85))
-            .border_style(BLACK)
-            .draw()
-            .map_err(boxed)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)?;
         Ok(())
     })
     .map_err(plot_err(file))
