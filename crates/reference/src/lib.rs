@@ -11,12 +11,14 @@
 //! | [`rotating_square`] | initial pressure of the rotating square patch, Colagrossi 2005 (§2) |
 //! | [`poiseuille`] | plane Poiseuille flow, steady and start-up, Morris et al. 1997 (§3a, §3b) |
 //! | [`entrance_length`] | laminar development length, Durst et al. 2005 (§3c) |
+//! | [`entrance_flow`] | developing channel flow from a uniform inlet, Bodoia & Osterle 1961 (§3c) |
 //! | [`pipe`] | Hagen–Poiseuille pipe flow, steady and start-up (§3d) |
 //! | [`capillarity`] | Laplace pressure, capillary oscillation and damping of drops (§4) |
 //! | [`taylor_green`] | 2D periodic Taylor–Green vortex |
 
 pub mod capillarity;
 pub mod elliptical_drop;
+pub mod entrance_flow;
 pub mod entrance_length;
 mod error;
 pub mod pipe;
