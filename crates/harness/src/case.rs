@@ -141,6 +141,14 @@ pub enum ReferenceSpec {
         /// Density \[kg/m^3\].
         density: f64,
     },
+    /// Plane Poiseuille start-up from rest (`meniscus_reference::poiseuille`); viscosity and
+    /// body force come from each run's scene.
+    PoiseuilleStartup {
+        /// Channel width D \[m\].
+        width: f64,
+        /// Position of the lower wall \[m\].
+        wall: f64,
+    },
 }
 
 /// A figure of the case page (drawn from results.json only).

@@ -167,7 +167,7 @@ pub fn assemble(case: &Case, tier: Tier, records: &[RunRecord]) -> Result<CaseRe
     let mut runs = Vec::with_capacity(records.len());
     for r in records {
         let probes = meniscus::ProbeRecord::from(r.probes.clone());
-        let measured = metrics::compute(&case.reference, &probes, r.summary.particles)
+        let measured = metrics::compute(&case.reference, &r.scene, &probes, r.summary.particles)
             .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
         runs.push(RunResult {
             scheme: r.scheme.clone(),

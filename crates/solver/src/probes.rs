@@ -51,6 +51,8 @@ pub struct ProbeSet<const D: usize> {
     weight: Weight,
     /// Own neighbour search of the disorder probe (pairs closer than Δx).
     search: Option<(CellSearch<D>, NeighbourList)>,
+    /// Scratch of the velocity profiles: per bin Σ position, Σ velocity, count.
+    bins: (Vec<f64>, Vec<f64>, Vec<usize>),
 }
 
 impl<const D: usize> ProbeSet<D> {
@@ -71,14 +73,15 @@ impl<const D: usize> ProbeSet<D> {
             .iter()
             .any(|(_, p)| matches!(p, Probe::Disorder {}))
             .then(|| (CellSearch::new(dx, domain), NeighbourList::default()));
-        Self { probes, weight, search }
+        Self { probes, weight, search, bins: Default::default() }
     }
 
     /// Appends one sample of every probe at time `t`.
     pub fn record(&mut self, s: &State<D>, t: f64, out: &mut ProbeRecord) {
         out.t.push(t);
-        let x = &s.particles.x;
-        let u = &s.particles.u;
+        let nf = s.particles.fluid;
+        let x = &s.particles.x[..nf];
+        let u = &s.particles.u[..nf];
         let mass = s.density * s.volume;
         for (key, probe) in &self.probes {
             match probe {
@@ -134,6 +137,38 @@ impl<const D: usize> ProbeSet<D> {
                     out.push(key, "min_pair_over_dx", min_pair / s.dx);
                     out.push(key, "close_fraction", close);
                 }
+                Probe::VelocityProfile { axis, component, range, bins, slab } => {
+                    let bins = &bins.unwrap_or(((range[1] - range[0]) / s.dx).round() as usize);
+                    let (sum_y, sum_u, count) = (&mut self.bins.0, &mut self.bins.1, &mut self.bins.2);
+                    for v in [&mut *sum_y, &mut *sum_u] {
+                        v.clear();
+                        v.resize(*bins, 0.0);
+                    }
+                    count.clear();
+                    count.resize(*bins, 0);
+                    let width = (range[1] - range[0]) / *bins as f64;
+                    for (p, v) in x.iter().zip(u) {
+                        if let Some(sl) = slab
+                            && !(sl.range[0] <= p[sl.axis] && p[sl.axis] <= sl.range[1])
+                        {
+                            continue;
+                        }
+                        let k = ((p[*axis] - range[0]) / width).floor();
+                        if k >= 0.0 && (k as usize) < *bins {
+                            let k = k as usize;
+                            sum_y[k] += p[*axis];
+                            sum_u[k] += v[*component];
+                            count[k] += 1;
+                        }
+                    }
+                    for k in 0..*bins {
+                        let c = count[k] as f64;
+                        let (y, v) =
+                            if count[k] > 0 { (sum_y[k] / c, sum_u[k] / c) } else { (f64::NAN, f64::NAN) };
+                        out.push(key, &format!("y_{k:03}"), y);
+                        out.push(key, &format!("u_{k:03}"), v);
+                    }
+                }
                 Probe::Solver {} => {
                     out.push(key, "free_surface_count", s.free_surface.iter().filter(|&&f| f).count() as f64);
                     out.push(key, "iterations", s.ppe.info.iterations as f64);
@@ -147,7 +182,7 @@ impl<const D: usize> ProbeSet<D> {
 /// Smallest pair distance \[m\] (Δx when no pair is closer) and the fraction of particles
 /// with a neighbour closer than 0.5 Δx; `list` holds the pairs closer than Δx.
 fn disorder<const D: usize>(s: &State<D>, list: &NeighbourList) -> (f64, f64) {
-    let x = &s.particles.x;
+    let x = &s.particles.x[..s.particles.fluid];
     let mut min = s.dx;
     let mut close = 0usize;
     for a in 0..x.len() {
@@ -172,5 +207,6 @@ pub fn kind_name(p: &Probe) -> &'static str {
         Probe::Momentum {} => "momentum",
         Probe::Disorder {} => "disorder",
         Probe::Solver {} => "solver",
+        Probe::VelocityProfile { .. } => "velocity_profile",
     }
 }

@@ -166,6 +166,7 @@ impl<const D: usize> Simulation<D> {
                 ));
             }
             for seed in lattice::seed_body::<D>(body, scene.dx, scene.fluid.density, &g) {
+                particles.fluid += 1;
                 particles.id.push(particles.x.len() as u32);
                 particles.x.push(seed.x);
                 particles.u.push(seed.u);
@@ -174,6 +175,16 @@ impl<const D: usize> Simulation<D> {
         }
         if particles.is_empty() {
             return Err(SceneError::new("bodies", scene.bodies.len(), "hold no particle"));
+        }
+        for (i, wall) in scene.boundaries.walls.iter().enumerate() {
+            let side = if wall.fluid_side == crate::scene::Side::Above { 1.0 } else { -1.0 };
+            if let Some(x) = particles.x.iter().find(|x| side * (x[wall.axis] - wall.position) <= 0.0) {
+                return Err(SceneError::new(
+                    format!("boundaries.walls[{i}].position"),
+                    wall.position,
+                    format!("leaves fluid particles behind the wall (one at {:?})", x.as_slice()),
+                ));
+            }
         }
         let mut domain = Domain::<D>::default();
         for axis in &scene.boundaries.periodic {
@@ -206,6 +217,7 @@ impl<const D: usize> Simulation<D> {
             h,
             domain,
             ppe: Default::default(),
+            mirrors: Default::default(),
         };
         let (stages, weight) = match scene.kernel.kind {
             KernelKind::CubicSpline => build::<CubicSpline, D>(scene, h, domain),
@@ -253,8 +265,12 @@ impl<const D: usize> Simulation<D> {
             observer.frame(&self.frame(0, 0.0));
         }
         let mut error = None;
+        // Requested probe times: steps are shortened to land on them.
+        let targets = self.scene.output.probe_times.clone();
+        let mut next = targets.iter().take_while(|&&s| s <= 0.0).count();
         while t < t_end * (1.0 - 1e-12) {
-            let dt = match self.time_step(t_end - t) {
+            let stop = targets.get(next).copied().filter(|&s| s < t_end).unwrap_or(t_end);
+            let dt = match self.time_step(stop - t) {
                 Ok(dt) => dt,
                 Err(cause) => {
                     error = Some(SolverError { stage: "time_step", step: step + 1, time: t, cause });
@@ -283,9 +299,14 @@ impl<const D: usize> Simulation<D> {
                 break;
             }
             step += 1;
-            t = if (t_end - (t + dt)).abs() <= 1e-12 * t_end { t_end } else { t + dt };
+            let landed = (stop - (t + dt)).abs() <= 1e-12 * t_end;
+            t = if landed { stop } else { t + dt };
             let last = t >= t_end * (1.0 - 1e-12);
-            if step % every == 0 || last {
+            let hit = landed && !last;
+            if hit {
+                next += 1;
+            }
+            if step % every == 0 || last || hit {
                 let s0 = Instant::now();
                 self.probes.record(&self.state, t, &mut record);
                 t_probes += s0.elapsed().as_secs_f64();
@@ -317,7 +338,8 @@ impl<const D: usize> Simulation<D> {
         RunReport { summary, probes: record, final_frame: self.frame(step, t), error }
     }
 
-    /// Δt of the next step, never past `remaining` (Qiu eqs. 17–19 when adaptive).
+    /// Δt of the next step, never past `remaining` (the time to the end or to the next
+    /// requested probe time; Qiu eqs. 17–19 when adaptive).
     fn time_step(&self, remaining: f64) -> Result<f64, Cause> {
         let dt = match self.scene.time.step {
             TimeStep::Fixed(dt) => dt,

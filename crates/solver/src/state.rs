@@ -6,11 +6,15 @@ use nalgebra::SVector;
 /// Vector type of the solver.
 pub type Vector<const D: usize> = SVector<f64, D>;
 
-/// Fluid particles, structure of arrays. Arrays are reordered by cell for locality;
-/// `id` keeps each particle's index in the initial order.
+/// Particles, structure of arrays: the `fluid` fluid particles first, then the boundary
+/// particles (wall mirrors, rebuilt every step) which only enter neighbour sums. Fluid
+/// particles are reordered by cell for locality; `id` keeps each one's index in the initial
+/// order.
 #[derive(Debug, Clone, Default)]
 pub struct Particles<const D: usize> {
-    /// Initial index of each particle.
+    /// Number of fluid particles (the leading entries of every array).
+    pub fluid: usize,
+    /// Initial index of each fluid particle.
     pub id: Vec<u32>,
     /// Positions \[m\].
     pub x: Vec<Vector<D>>,
@@ -21,14 +25,19 @@ pub struct Particles<const D: usize> {
 }
 
 impl<const D: usize> Particles<D> {
-    /// Number of particles.
+    /// Number of fluid particles.
     pub fn len(&self) -> usize {
-        self.x.len()
+        self.fluid
     }
 
-    /// True if there are none.
+    /// True if there is no fluid particle.
     pub fn is_empty(&self) -> bool {
-        self.x.is_empty()
+        self.fluid == 0
+    }
+
+    /// Fluid and boundary particles together.
+    pub fn total(&self) -> usize {
+        self.x.len()
     }
 }
 
@@ -79,6 +88,18 @@ pub struct State<const D: usize> {
     pub domain: Domain<D>,
     /// The assembled pressure Poisson system of the current step.
     pub ppe: PpeSystem,
+    /// Where each boundary particle's values come from.
+    pub mirrors: Mirrors,
+}
+
+/// Boundary particles that mirror fluid particles: boundary particle `fluid + k` takes its
+/// velocity as `sign[k] · u[source[k]]` and its pressure as `p[source[k]]`.
+#[derive(Debug, Clone, Default)]
+pub struct Mirrors {
+    /// Fluid particle mirrored.
+    pub source: Vec<u32>,
+    /// Velocity factor: −1 after one no-slip reflection, +1 after two (a corner).
+    pub sign: Vec<f64>,
 }
 
 /// The PPE of the current step: matrix, right-hand side and the particle ↔ row maps.
@@ -101,17 +122,18 @@ pub struct PpeSystem {
 }
 
 impl<const D: usize> State<D> {
-    /// Largest particle speed \[m/s\] (order-independent reduction).
+    /// Largest fluid particle speed \[m/s\] (order-independent reduction).
     pub fn max_speed(&self) -> f64 {
-        self.particles.u.iter().map(|u| u.norm_squared()).fold(0.0, f64::max).sqrt()
+        self.particles.u[..self.particles.fluid].iter().map(|u| u.norm_squared()).fold(0.0, f64::max).sqrt()
     }
 
-    /// Applies the permutation `perm` (new → old) to every particle array.
+    /// Applies the permutation `perm` (new → old) of the fluid particles to every particle
+    /// array (the leading `perm.len()` entries; boundary particles keep their place).
     pub fn permute(&mut self, perm: &[u32]) {
-        fn apply<T: Copy>(v: &mut Vec<T>, perm: &[u32]) {
-            if v.len() == perm.len() {
+        fn apply<T: Copy>(v: &mut [T], perm: &[u32]) {
+            if v.len() >= perm.len() {
                 let new: Vec<T> = perm.iter().map(|&i| v[i as usize]).collect();
-                *v = new;
+                v[..perm.len()].copy_from_slice(&new);
             }
         }
         apply(&mut self.particles.id, perm);

@@ -7,6 +7,7 @@
 //! `|x(t) - x(0)| / |x(0)|`). Non-finite samples make the norm NaN (never silently skipped).
 
 pub mod elliptical_drop;
+pub mod poiseuille;
 
 use crate::case::ReferenceSpec;
 use meniscus::ProbeRecord;
@@ -21,15 +22,20 @@ pub struct Measured {
     pub series: BTreeMap<String, Vec<f64>>,
 }
 
-/// Computes the metrics of a run's probes against `reference`.
+/// Computes the metrics of a run's probes against `reference`; `scene` is the run's
+/// effective scene (references may take physical parameters from it).
 pub fn compute(
     reference: &ReferenceSpec,
+    scene: &serde_json::Value,
     probes: &ProbeRecord,
     particles: usize,
 ) -> Result<Measured, meniscus_reference::ReferenceError> {
     let mut m = match *reference {
         ReferenceSpec::EllipticalDrop { radius, a0, density } => {
             elliptical_drop::compute(&elliptical_drop::Params { radius, a0, density }, probes)?
+        }
+        ReferenceSpec::PoiseuilleStartup { width, wall } => {
+            poiseuille::compute(&poiseuille::channel(width, scene)?, wall, probes)?
         }
     };
     m.metrics.insert("particles".into(), particles as f64);

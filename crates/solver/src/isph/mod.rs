@@ -1,8 +1,9 @@
 //! Projection ISPH (Qiu 2013 §2.2–2.6; Cummins & Rudman 1999; Shao & Lo 2003).
 //!
 //! The step, built from the scene (a stage the scene does not need is not built):
-//! `advect` (eq. 3) → `neighbours` → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13;
-//! μ > 0 only) → `body_force` (eq. 4; g ≠ 0 only) → `ppe_assemble` (eqs. 10, 12) →
+//! `reorder` (locality) → `advect` (eq. 3) → `walls` (§2.4.2; walls only) → `neighbours` →
+//! `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; μ > 0 only) → `body_force` (eq. 4;
+//! g ≠ 0 only) → `mirror_velocity` (walls only) → `ppe_assemble` (eqs. 10, 12) →
 //! `ppe_solve` (eq. 5) → `correction` (eqs. 6, 15) → `position` (eq. 7) → `shifting`
 //! (eqs. 20–21; when configured).
 
@@ -14,7 +15,7 @@ use crate::kernel::{Kernel, Scaled};
 use crate::ppe::PpeSolve;
 use crate::scene::{IsphOptions, Scene, Shifting as ShiftSpec};
 use crate::stage::Stage;
-use crate::stages::{free_surface::FreeSurface, neighbours::Neighbours};
+use crate::stages::{free_surface::FreeSurface, neighbours::Neighbours, reorder::Reorder, walls};
 use crate::state::Vector;
 
 /// Particles are reordered by cell every this many steps.
@@ -27,17 +28,23 @@ pub fn build_stages<K: Kernel, const D: usize>(
     kernel: Scaled<K, D>,
     domain: crate::neighbours::Domain<D>,
 ) -> Vec<Box<dyn Stage<D>>> {
-    let mut stages: Vec<Box<dyn Stage<D>>> = vec![
-        Box::new(predictor::Advect),
-        Box::new(Neighbours::new(kernel, domain, REORDER_EVERY)),
-        Box::new(FreeSurface { threshold: opts.free_surface_threshold }),
-    ];
+    let mut stages: Vec<Box<dyn Stage<D>>> =
+        vec![Box::new(Reorder::new(kernel.support, domain, REORDER_EVERY)), Box::new(predictor::Advect)];
+    let has_walls = !scene.boundaries.walls.is_empty();
+    if has_walls {
+        stages.push(Box::new(walls::Walls::new(&scene.boundaries.walls, kernel.support)));
+    }
+    stages.push(Box::new(Neighbours::new(kernel, domain)));
+    stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold }));
     if scene.fluid.viscosity > 0.0 {
         stages.push(Box::new(predictor::Viscosity { nu: scene.fluid.viscosity / scene.fluid.density }));
     }
     let g = Vector::<D>::from_fn(|i, _| scene.body_force.get(i).copied().unwrap_or(0.0));
     if g.norm_squared() > 0.0 {
         stages.push(Box::new(predictor::BodyForce { g }));
+    }
+    if has_walls {
+        stages.push(Box::new(walls::MirrorVelocity));
     }
     stages.push(Box::new(projection::PpeAssemble { divergence: opts.divergence }));
     stages.push(Box::new(projection::PpeSolveStage { solver: PpeSolve::new(opts.ppe) }));

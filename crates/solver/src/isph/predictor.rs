@@ -17,9 +17,10 @@ impl<const D: usize> Stage<D> for Advect {
     fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
         s.x_old.clone_from(&s.particles.x);
         s.u_old.clone_from(&s.particles.u);
-        let (dt, dom) = (ctx.dt, s.domain);
+        let (dt, dom, nf) = (ctx.dt, s.domain, s.particles.fluid);
         let periodic = dom.is_periodic();
-        s.particles.x.par_iter_mut().zip(s.particles.u.par_iter()).with_min_len(512).for_each(|(x, u)| {
+        let (x, u) = (&mut s.particles.x[..nf], &s.particles.u[..nf]);
+        x.par_iter_mut().zip(u.par_iter()).with_min_len(512).for_each(|(x, u)| {
             *x += u * dt;
             if periodic {
                 dom.wrap(x);
@@ -47,7 +48,7 @@ impl<const D: usize> Stage<D> for Viscosity {
         let eta2 = 0.01 * s.h * s.h;
         let c = ctx.dt * self.nu * 2.0 * s.volume;
         let (list, pairs, u_old) = (&s.neighbours, &s.pairs, &s.u_old);
-        s.particles.u.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
+        s.particles.u[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let mut lap = Vector::<D>::zeros();
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
@@ -73,7 +74,7 @@ impl<const D: usize> Stage<D> for BodyForce<D> {
 
     fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
         let du = self.g * ctx.dt;
-        s.particles.u.par_iter_mut().with_min_len(1024).for_each(|u| *u += du);
+        s.particles.u[..s.particles.fluid].par_iter_mut().with_min_len(1024).for_each(|u| *u += du);
         Ok(())
     }
 }

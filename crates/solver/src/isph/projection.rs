@@ -27,7 +27,7 @@ impl<const D: usize> Stage<D> for PpeAssemble {
     fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
         let n = s.particles.len();
         let sys = &mut s.ppe;
-        sys.row_of.resize(n, u32::MAX);
+        sys.row_of.resize(s.particles.total(), u32::MAX);
         sys.particle_of.clear();
         for a in 0..n {
             if s.free_surface[a] {
@@ -36,6 +36,10 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                 sys.row_of[a] = sys.particle_of.len() as u32;
                 sys.particle_of.push(a as u32);
             }
+        }
+        // A mirror's pressure is its source's: it shares the source's unknown.
+        for (k, &src) in s.mirrors.source.iter().enumerate() {
+            sys.row_of[n + k] = sys.row_of[src as usize];
         }
         let rows = sys.particle_of.len();
         sys.singular = rows == n;
@@ -46,7 +50,15 @@ impl<const D: usize> Stage<D> for PpeAssemble {
         m.row_ptr[0] = 0;
         m.row_ptr[1..].par_iter_mut().enumerate().with_min_len(256).for_each(|(i, len)| {
             let a = particle_of[i] as usize;
-            *len = 1 + list.of(a).iter().filter(|&&b| row_of[b as usize] != u32::MAX).count();
+            let own = i as u32;
+            *len = 1 + list
+                .of(a)
+                .iter()
+                .filter(|&&b| {
+                    let rb = row_of[b as usize];
+                    rb != u32::MAX && rb != own
+                })
+                .count();
         });
         for i in 0..rows {
             m.row_ptr[i + 1] += m.row_ptr[i];
@@ -61,9 +73,13 @@ impl<const D: usize> Stage<D> for PpeAssemble {
             let mut diag = 0.0;
             let mut k = 1;
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+                let rb = row_of[b as usize];
+                if rb == i as u32 {
+                    // The particle's own mirror: c (p_a − p_a) = 0.
+                    continue;
+                }
                 let c = -2.0 * v * p.f * p.r2 / (rho * (p.r2 + eta2));
                 diag += c;
-                let rb = row_of[b as usize];
                 if rb != u32::MAX {
                     row[k] = (rb, -c);
                     k += 1;
@@ -131,6 +147,10 @@ impl<const D: usize> Stage<D> for PpeSolveStage {
         for (x, &a) in sys.solution.iter().zip(&sys.particle_of) {
             p[a as usize] = *x;
         }
+        let (fluid, mirrors) = p.split_at_mut(s.particles.fluid);
+        for (pm, &src) in mirrors.iter_mut().zip(&s.mirrors.source) {
+            *pm = fluid[src as usize];
+        }
         Ok(())
     }
 }
@@ -156,7 +176,7 @@ impl<const D: usize> Stage<D> for Correction {
             PressureGradient::Symmetric => 1.0,
             PressureGradient::Difference => -1.0,
         };
-        s.particles.u.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
+        s.particles.u[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let mut g = Vector::<D>::zeros();
             for (pr, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
@@ -181,7 +201,7 @@ impl<const D: usize> Stage<D> for Position {
         let (dt, dom) = (ctx.dt, s.domain);
         let periodic = dom.is_periodic();
         let (x_old, u_old, u) = (&s.x_old, &s.u_old, &s.particles.u);
-        s.particles.x.par_iter_mut().enumerate().with_min_len(512).for_each(|(a, x)| {
+        s.particles.x[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(512).for_each(|(a, x)| {
             *x = x_old[a] + (u[a] + u_old[a]) * (0.5 * dt);
             if periodic {
                 dom.wrap(x);

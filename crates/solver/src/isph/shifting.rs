@@ -117,10 +117,9 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
         );
         let periodic = dom.is_periodic();
         let (shift, du) = (&self.shift, &self.du);
-        s.particles
-            .x
+        s.particles.x[..n]
             .par_iter_mut()
-            .zip(s.particles.u.par_iter_mut())
+            .zip(s.particles.u[..n].par_iter_mut())
             .enumerate()
             .with_min_len(512)
             .for_each(|(a, (x, u))| {

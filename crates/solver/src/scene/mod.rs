@@ -4,6 +4,7 @@
 pub mod lattice;
 pub mod schema;
 mod validate;
+mod validate_boundaries;
 
 pub use schema::*;
 pub use validate::validate;

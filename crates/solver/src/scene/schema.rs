@@ -179,6 +179,46 @@ pub struct Boundaries {
     /// Periodic axes (0 = x, 1 = y, 2 = z) with their period.
     #[serde(default)]
     pub periodic: Vec<PeriodicAxis>,
+    /// Plane no-slip walls (none: no wall stage is built).
+    #[serde(default)]
+    pub walls: Vec<Wall>,
+    /// How walls are represented.
+    #[serde(default)]
+    pub wall_model: WallModel,
+}
+
+/// A plane no-slip wall at rest, normal to a coordinate axis: `x[axis] = position`, the
+/// fluid on `fluid_side`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Wall {
+    /// Axis of the wall normal (0 = x, 1 = y, 2 = z).
+    pub axis: usize,
+    /// Position of the wall plane on that axis \[m\].
+    pub position: f64,
+    /// The side of the plane the fluid is on.
+    pub fluid_side: Side,
+}
+
+/// A side of a plane normal to an axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Side {
+    /// Coordinates above the plane (`x[axis] > position`).
+    Above,
+    /// Coordinates below the plane (`x[axis] < position`).
+    Below,
+}
+
+/// Wall representation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum WallModel {
+    /// Mirror particles rebuilt every step (Qiu 2013 §2.4.2): every fluid particle within the
+    /// kernel support of a wall is reflected across it, with velocity `−u` (no slip) and its
+    /// own pressure; near a corner it is reflected across both walls too.
+    #[default]
+    Mirror,
 }
 
 /// One periodic axis: positions wrap into `[min, max)`.
@@ -340,10 +380,38 @@ pub enum Probe {
     Disorder {},
     /// Free-surface particle count `count`, PPE iterations `iterations` and residual `residual`.
     Solver {},
+    /// Velocity profile across a channel: the fluid in `range` along `axis` (optionally only
+    /// where `slab.axis` lies in `slab.range`) is split into equal bins; each bin
+    /// records the mean position `y_###` \[m\] and the mean velocity component `u_###`
+    /// \[m/s\] of its particles (NaN when empty), `###` the zero-padded bin index.
+    VelocityProfile {
+        /// Axis across the profile (1 = y for a channel along x).
+        axis: usize,
+        /// Velocity component recorded (0 = u_x).
+        component: usize,
+        /// Extent of the profile along `axis` \[m\].
+        range: [f64; 2],
+        /// Number of bins (1–999); absent: one per particle row, `round((range[1] − range[0]) / Δx)`.
+        #[serde(default)]
+        bins: Option<usize>,
+        /// Restrict to particles with `x[slab.axis]` in `slab.range` (all if absent).
+        #[serde(default)]
+        slab: Option<Slab>,
+    },
+}
+
+/// A slab `range[0] <= x[axis] <= range[1]`.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Slab {
+    /// Axis normal to the slab.
+    pub axis: usize,
+    /// Extent on that axis \[m\].
+    pub range: [f64; 2],
 }
 
 /// Output cadence.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OutputSpec {
     /// Record probes every this many steps (and at t = 0 and the last step).
@@ -352,11 +420,15 @@ pub struct OutputSpec {
     /// Write a VTK frame every this many steps (0 = none; `meniscus run --vtk` sets it).
     #[serde(default)]
     pub vtk_every: usize,
+    /// Times \[s\] at which probes are also recorded; steps are shortened to land on them
+    /// exactly (increasing, within the end time).
+    #[serde(default)]
+    pub probe_times: Vec<f64>,
 }
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        Self { probe_every: default_probe_every(), vtk_every: 0 }
+        Self { probe_every: default_probe_every(), vtk_every: 0, probe_times: Vec::new() }
     }
 }
 

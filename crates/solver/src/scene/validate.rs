@@ -100,7 +100,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     if scene.output.probe_every == 0 {
         return Err(SceneError::new("output.probe_every", 0, "must be at least 1"));
     }
-    Ok(())
+    super::validate_boundaries::validate(scene)
 }
 
 /// Largest particle count a scene may ask for (memory: about 1 kB per particle).

@@ -1,4 +1,4 @@
-//! Neighbour stage: cell-list search, reordering by cell, and the pair cache.
+//! Neighbour stage: cell-list search and the pair cache.
 
 use crate::error::Cause;
 use crate::kernel::{Kernel, Scaled};
@@ -6,21 +6,19 @@ use crate::neighbours::CellSearch;
 use crate::stage::{Stage, StepContext, par_rows_mut};
 use crate::state::{Pair, State};
 
-/// Rebuilds the neighbour lists at the current positions and fills the pair cache
-/// (`r_ab`, `r²`, `W'(r)/r`). Every `reorder_every` calls the particles are first
-/// reordered by cell for memory locality.
+/// Rebuilds the neighbour lists of the fluid particles at the current positions (their
+/// neighbours include boundary particles) and fills the pair cache (`r_ab`, `r²`,
+/// `W'(r)/r`).
 #[derive(Debug)]
 pub struct Neighbours<K: Kernel, const D: usize> {
     search: CellSearch<D>,
     kernel: Scaled<K, D>,
-    reorder_every: usize,
-    calls: usize,
 }
 
 impl<K: Kernel, const D: usize> Neighbours<K, D> {
     /// A stage for `kernel` in `domain`; search radius = kernel support.
-    pub fn new(kernel: Scaled<K, D>, domain: crate::neighbours::Domain<D>, reorder_every: usize) -> Self {
-        Self { search: CellSearch::new(kernel.support, domain), kernel, reorder_every, calls: 0 }
+    pub fn new(kernel: Scaled<K, D>, domain: crate::neighbours::Domain<D>) -> Self {
+        Self { search: CellSearch::new(kernel.support, domain), kernel }
     }
 }
 
@@ -30,12 +28,7 @@ impl<K: Kernel, const D: usize> Stage<D> for Neighbours<K, D> {
     }
 
     fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
-        if self.reorder_every > 0 && self.calls.is_multiple_of(self.reorder_every) {
-            let perm = self.search.cell_order(&s.particles.x);
-            s.permute(&perm);
-        }
-        self.calls += 1;
-        self.search.build(&s.particles.x, &mut s.neighbours);
+        self.search.build_rows(&s.particles.x, s.particles.fluid, &mut s.neighbours);
         let n_pairs = s.neighbours.pairs();
         s.pairs.resize(n_pairs, Pair::default());
         let (x, list, dom, k) = (&s.particles.x, &s.neighbours, s.domain, self.kernel);

@@ -1,0 +1,75 @@
+//! Value checks of walls, velocity profiles and probe times (split from `validate` to keep
+//! each file about one part of the scene). Every rule names the field, the value and the
+//! rule.
+
+use super::schema::*;
+use crate::error::SceneError;
+
+/// Checks `boundaries.walls`, the `velocity_profile` probes and `output.probe_times`.
+pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
+    let d = scene.dimension;
+    for (i, wall) in scene.boundaries.walls.iter().enumerate() {
+        let f = format!("boundaries.walls[{i}]");
+        axis(&format!("{f}.axis"), wall.axis, d)?;
+        if scene.boundaries.periodic.iter().any(|p| p.axis == wall.axis) {
+            return Err(SceneError::new(
+                format!("{f}.axis"),
+                wall.axis,
+                "is also a periodic axis (a wall and a period cannot share an axis)",
+            ));
+        }
+        finite(&format!("{f}.position"), wall.position)?;
+    }
+    for (i, probe) in scene.probes.iter().enumerate() {
+        if let Probe::VelocityProfile { axis: a, component, range, bins, slab } = probe {
+            let f = format!("probes[{i}].velocity_profile");
+            axis(&format!("{f}.axis"), *a, d)?;
+            axis(&format!("{f}.component"), *component, d)?;
+            ordered(&format!("{f}.range"), range)?;
+            let n = bins.unwrap_or(((range[1] - range[0]) / scene.dx).round() as usize);
+            if !(1..=999).contains(&n) {
+                let rule = if bins.is_some() {
+                    "must be between 1 and 999"
+                } else {
+                    "(one per row of Δx) must be between 1 and 999"
+                };
+                return Err(SceneError::new(format!("{f}.bins"), n, rule));
+            }
+            if let Some(slab) = slab {
+                axis(&format!("{f}.slab.axis"), slab.axis, d)?;
+                ordered(&format!("{f}.slab.range"), &slab.range)?;
+            }
+        }
+    }
+    let mut last = 0.0;
+    for (i, &t) in scene.output.probe_times.iter().enumerate() {
+        let f = format!("output.probe_times[{i}]");
+        finite(&f, t)?;
+        if t <= last {
+            return Err(SceneError::new(f, t, "must be positive and larger than the time before it"));
+        }
+        if t > scene.time.end {
+            return Err(SceneError::new(f, t, "must not exceed time.end"));
+        }
+        last = t;
+    }
+    Ok(())
+}
+
+fn finite(field: &str, v: f64) -> Result<(), SceneError> {
+    if v.is_finite() { Ok(()) } else { Err(SceneError::new(field, v, "must be finite")) }
+}
+
+fn axis(field: &str, a: usize, d: usize) -> Result<(), SceneError> {
+    if a < d { Ok(()) } else { Err(SceneError::new(field, a, "must be an axis of the scene (0..dimension)")) }
+}
+
+fn ordered(field: &str, r: &[f64; 2]) -> Result<(), SceneError> {
+    finite(&format!("{field}[0]"), r[0])?;
+    finite(&format!("{field}[1]"), r[1])?;
+    if r[1] > r[0] {
+        Ok(())
+    } else {
+        Err(SceneError::new(format!("{field}[1]"), r[1], "must exceed range[0]"))
+    }
+}

@@ -1,0 +1,199 @@
+//! Mirror walls (Qiu 2013 §2.4.2), periodic channels and the probes that measure them.
+// Exact comparisons are the point of several checks here: mirror velocities are exact
+// copies, requested probe times are landed on exactly, a channel at rest has u = 0.
+#![allow(clippy::float_cmp)]
+
+use meniscus::Scene;
+use meniscus::run::Simulation;
+use meniscus_reference::poiseuille::PlanePoiseuille;
+use serde_json::{Value, json};
+
+const D: f64 = 0.2;
+const NU: f64 = 1e-6;
+
+/// A periodic channel of width D between mirror walls, `rows` particle rows, driven by
+/// `force` from rest, to `end` seconds, with the PPE solver `solver`.
+fn channel(rows: usize, force: f64, end: f64, solver: &str) -> Value {
+    let dx = D / rows as f64;
+    json!({
+        "name": "channel", "dimension": 2, "dx": dx,
+        "kernel": { "kind": "cubic_spline", "h_over_dx": 1.5 },
+        "fluid": { "density": 1000.0, "viscosity": 1e-3 },
+        "body_force": [force, 0.0],
+        "bodies": [ { "role": "fluid", "shape": { "rectangle": { "min": [0.0, 0.0], "max": [D / 2.0, D] } } } ],
+        "boundaries": {
+            "periodic": [ { "axis": 0, "min": 0.0, "max": D / 2.0 } ],
+            "walls": [ { "axis": 1, "position": 0.0, "fluid_side": "above" },
+                       { "axis": 1, "position": D, "fluid_side": "below" } ]
+        },
+        "scheme": { "isph": { "ppe": { "solver": solver, "tolerance": 1e-8, "max_iterations": 5000 },
+                              "free_surface_threshold": 1.5 } },
+        "time": { "end": end, "step": { "adaptive": { "cfl": 0.2, "viscous": 0.2, "max": 100.0 } } },
+        "probes": [ { "velocity_profile": { "axis": 1, "component": 0, "range": [0.0, D] } }, { "solver": {} } ],
+        "output": { "probe_every": 1000, "probe_times": [0.02 * D * D / NU] }
+    })
+}
+
+fn scene(v: &Value) -> Scene {
+    Scene::from_json(&v.to_string()).expect("valid scene")
+}
+
+/// Relative L2 error of the recorded profile at sample `i` against the start-up series.
+fn profile_error(report: &meniscus::RunReport, force: f64, i: usize) -> f64 {
+    let exact = PlanePoiseuille::new(D, force, NU).expect("valid channel");
+    let t = report.probes.t[i];
+    let (mut num, mut den) = (0.0, 0.0);
+    for k in 0.. {
+        let (Some(y), Some(u)) = (
+            report.probes.get("velocity_profile", &format!("y_{k:03}")),
+            report.probes.get("velocity_profile", &format!("u_{k:03}")),
+        ) else {
+            break;
+        };
+        let r = exact.velocity(y[i].clamp(0.0, D), t).expect("inside");
+        num += (u[i] - r).powi(2);
+        den += r * r;
+    }
+    (num / den).sqrt()
+}
+
+/// Start-up to τ = 0.05 with `rows` rows: the run and its profile errors at τ = 0.02, 0.05.
+fn start_up(rows: usize, force: f64) -> (meniscus::RunReport, f64, f64) {
+    let t_probe = 0.02 * D * D / NU;
+    let report = meniscus::run(&scene(&channel(rows, force, 0.05 * D * D / NU, "cg")), &mut meniscus::Quiet)
+        .expect("scene builds");
+    assert!(report.error.is_none(), "{:?}", report.error);
+    let i = report.probes.t.iter().position(|&t| t == t_probe).expect("a sample exactly at the probe time");
+    let early = profile_error(&report, force, i);
+    let last = profile_error(&report, force, report.probes.t.len() - 1);
+    (report, early, last)
+}
+
+#[test]
+fn start_up_follows_the_series_converges_and_lands_on_probe_times() {
+    let force = 6e-8;
+    let (report, early, last) = start_up(20, force);
+    let (_, early40, last40) = start_up(40, force);
+    // Measured: 1.6 % at τ = 0.02 and 1.0 % at τ = 0.05 with 20 rows; 40 rows halve them.
+    assert!(early < 0.025, "τ = 0.02: {early}");
+    assert!(last < 0.015, "τ = 0.05: {last}");
+    assert!(early40 < 0.7 * early && last40 < 0.7 * last, "40 rows: {early40}, {last40}");
+    // Without walls the fluid would accelerate freely: u = F t everywhere.
+    let free = force * report.summary.t_end;
+    let u_wall_row = report.probes.get("velocity_profile", "u_000").expect("profile");
+    assert!(u_wall_row[u_wall_row.len() - 1] < 0.5 * free, "no wall drag: {u_wall_row:?}");
+}
+
+#[test]
+fn a_channel_at_rest_stays_at_rest() {
+    let report = meniscus::run(&scene(&channel(10, 0.0, 2000.0, "bicgstab")), &mut meniscus::Quiet)
+        .expect("scene builds");
+    assert!(report.error.is_none(), "{:?}", report.error);
+    let e = report.final_frame.u.iter().map(|u| u[0].abs().max(u[1].abs())).fold(0.0, f64::max);
+    assert_eq!(e, 0.0, "spurious velocity {e}");
+}
+
+#[test]
+fn krylov_and_direct_solvers_agree_with_mirrors() {
+    // The mirrors make duplicate columns (a particle and its source's mirror); the direct
+    // factorisation must sum them as the Krylov products do.
+    let run = |solver: &str| {
+        let mut v = channel(10, 6e-8, 3000.0, solver);
+        v["output"]["probe_times"] = json!([]);
+        let r = meniscus::run(&scene(&v), &mut meniscus::Quiet).expect("scene builds");
+        assert!(r.error.is_none(), "{solver}: {:?}", r.error);
+        r.final_frame
+    };
+    let (cg, bicg, direct) = (run("cg"), run("bicgstab"), run("direct"));
+    let diff = |a: &meniscus::Frame, b: &meniscus::Frame| {
+        a.u.iter().zip(&b.u).map(|(x, y)| (x[0] - y[0]).abs() + (x[1] - y[1]).abs()).fold(0.0, f64::max)
+    };
+    let scale = cg.u.iter().map(|u| u[0].abs()).fold(0.0, f64::max);
+    assert!(scale > 0.0);
+    assert!(diff(&cg, &direct) < 1e-6 * scale, "cg vs direct {}", diff(&cg, &direct));
+    assert!(diff(&bicg, &direct) < 1e-6 * scale, "bicgstab vs direct {}", diff(&bicg, &direct));
+}
+
+#[test]
+fn corner_particles_are_mirrored_twice() {
+    // A box corner: walls x = 0 and y = 0, fluid in [0, 0.1]².
+    let v = json!({
+        "name": "corner", "dimension": 2, "dx": 0.01,
+        "kernel": { "kind": "cubic_spline", "h_over_dx": 1.5 },
+        "fluid": { "density": 1000.0, "viscosity": 1e-3 },
+        "bodies": [ { "role": "fluid", "shape": { "rectangle": { "min": [0.0, 0.0], "max": [0.1, 0.1] } },
+                      "velocity": { "affine": { "gradient": [[0.0, 0.0], [0.0, 0.0]], "offset": [0.01, 0.02] } } } ],
+        "boundaries": { "walls": [ { "axis": 0, "position": 0.0, "fluid_side": "above" },
+                                   { "axis": 1, "position": 0.0, "fluid_side": "above" } ] },
+        "scheme": { "isph": { "ppe": { "solver": "bicgstab", "tolerance": 1e-3, "max_iterations": 100 },
+                              "free_surface_threshold": 1.5 } },
+        "time": { "end": 1e-6, "step": { "fixed": 1e-6 } }
+    });
+    let mut sim = Simulation::<2>::new(&scene(&v)).expect("builds");
+    let report = sim.run(&mut meniscus::Quiet);
+    assert!(report.error.is_none(), "{:?}", report.error);
+    let s = sim.state();
+    let support = 3.0 * 0.01;
+    let nf = s.particles.fluid;
+    let (mut singles, mut doubles) = (0, 0);
+    for (k, (&src, &sign)) in s.mirrors.source.iter().zip(&s.mirrors.sign).enumerate() {
+        let (g, x) = (s.particles.x[nf + k], s.particles.x[src as usize]);
+        // The mirrors were made at the advected positions; the sources have moved by
+        // about Δt |u| = 2e-8 m since.
+        let flipped: Vec<bool> = (0..2).map(|i| (g[i] + x[i]).abs() < 1e-6).collect();
+        let n = flipped.iter().filter(|&&f| f).count();
+        assert!(n >= 1, "mirror {k} is not a reflection of its source");
+        for i in 0..2 {
+            if flipped[i] {
+                assert!(x[i] < support, "source too far from wall {i}");
+            } else {
+                assert!((g[i] - x[i]).abs() < 1e-6);
+            }
+        }
+        assert_eq!(sign, if n == 1 { -1.0 } else { 1.0 });
+        // Velocities at the start of the step: the mirror's is exactly sign × its source's.
+        assert_eq!(s.u_old[nf + k], s.u_old[src as usize] * sign);
+        if n == 1 { singles += 1 } else { doubles += 1 }
+    }
+    // Three rows/columns within the support of each wall; 3 × 3 in the corner.
+    assert_eq!(doubles, 9);
+    assert_eq!(singles, 2 * 3 * 10);
+}
+
+#[test]
+fn wall_and_profile_errors_name_the_field() {
+    let mut base = channel(10, 0.0, 100.0, "cg");
+    base["output"]["probe_times"] = json!([]);
+    type Edit = Box<dyn Fn(&mut Value)>;
+    let cases: Vec<(Edit, &str)> = vec![
+        (Box::new(|v| v["boundaries"]["walls"][0]["axis"] = json!(0)), "boundaries.walls[0].axis"),
+        (Box::new(|v| v["boundaries"]["walls"][0]["axis"] = json!(2)), "boundaries.walls[0].axis"),
+        (Box::new(|v| v["boundaries"]["walls"][1]["position"] = json!(0.1)), "boundaries.walls[1].position"),
+        (
+            Box::new(|v| v["boundaries"]["walls"][0]["fluid_side"] = json!("left")),
+            "boundaries.walls[0].fluid_side",
+        ),
+        (
+            Box::new(|v| v["probes"][0]["velocity_profile"]["bins"] = json!(0)),
+            "probes[0].velocity_profile.bins",
+        ),
+        (
+            Box::new(|v| v["probes"][0]["velocity_profile"]["range"] = json!([0.2, 0.0])),
+            "probes[0].velocity_profile.range[1]",
+        ),
+        (
+            Box::new(|v| v["probes"][0]["velocity_profile"]["component"] = json!(3)),
+            "probes[0].velocity_profile.component",
+        ),
+        (Box::new(|v| v["output"]["probe_times"] = json!([50.0, 40.0])), "output.probe_times[1]"),
+        (Box::new(|v| v["output"]["probe_times"] = json!([500.0])), "output.probe_times[0]"),
+    ];
+    for (edit, field) in cases {
+        let mut v = base.clone();
+        edit(&mut v);
+        let err = Scene::from_json(&v.to_string())
+            .and_then(|s| meniscus::AnySimulation::new(&s).map(|_| ()))
+            .expect_err(field);
+        assert!(err.to_string().contains(field), "{field}: {err}");
+    }
+}
