@@ -5,8 +5,9 @@ use crate::error::{Cause, SceneError, SolverError};
 use crate::kernel::{CubicSpline, Kernel, Scaled, WendlandC2};
 use crate::neighbours::Domain;
 use crate::probes::{ProbeRecord, ProbeSet, Weight};
-use crate::scene::{KernelKind, Role, Scene, Scheme, TimeStep, lattice};
+use crate::scene::{KernelKind, Role, Scene, Scheme, TimeStep, WallModel, lattice};
 use crate::stage::{Stage, StepContext};
+use crate::stages::dummy::dummy_layers;
 use crate::state::{Particles, State, Vector};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -192,6 +193,14 @@ impl<const D: usize> Simulation<D> {
         }
         for x in &mut particles.x {
             domain.wrap(x);
+        }
+        if scene.boundaries.wall_model == WallModel::Dummy && !scene.boundaries.walls.is_empty() {
+            let depth = 2.0 * scene.h();
+            for x in dummy_layers(&scene.boundaries.walls, &domain, &particles.x, scene.dx, depth) {
+                particles.x.push(x);
+                particles.u.push(Vector::zeros());
+                particles.p.push(0.0);
+            }
         }
         let mut lo = Vector::<D>::repeat(f64::INFINITY);
         let mut hi = Vector::<D>::repeat(f64::NEG_INFINITY);

@@ -37,12 +37,15 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                 sys.particle_of.push(a as u32);
             }
         }
-        // A mirror's pressure is its source's: it shares the source's unknown.
+        // A mirror's pressure is its source's: it shares the source's unknown. Other
+        // boundary particles (dummy walls) carry known pressures.
+        sys.row_of[n..].fill(u32::MAX);
         for (k, &src) in s.mirrors.source.iter().enumerate() {
             sys.row_of[n + k] = sys.row_of[src as usize];
         }
         let rows = sys.particle_of.len();
-        sys.singular = rows == n;
+        let known_boundary = s.particles.total() > n + s.mirrors.source.len();
+        sys.singular = rows == n && !known_boundary;
         let (list, row_of, particle_of) = (&s.neighbours, &sys.row_of, &sys.particle_of);
         // Row lengths: the diagonal plus the interior neighbours.
         let m = &mut sys.matrix;
@@ -94,6 +97,7 @@ impl<const D: usize> Stage<D> for PpeAssemble {
         });
         sys.rhs.resize(rows, 0.0);
         let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
+        let p = &s.particles.p;
         sys.rhs.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
             let a = particle_of[i] as usize;
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
@@ -116,7 +120,16 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                 }
                 v * div
             };
-            *r = -div * inv_dt;
+            // Known boundary pressures (dummy walls) move to the right-hand side.
+            let mut known = 0.0;
+            if known_boundary {
+                for (pr, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+                    if b as usize >= n && row_of[b as usize] == u32::MAX {
+                        known += -2.0 * v * pr.f * pr.r2 / (rho * (pr.r2 + eta2)) * p[b as usize];
+                    }
+                }
+            }
+            *r = -div * inv_dt + known;
         });
         Ok(())
     }

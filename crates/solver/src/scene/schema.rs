@@ -219,6 +219,10 @@ pub enum WallModel {
     /// own pressure; near a corner it is reflected across both walls too.
     #[default]
     Mirror,
+    /// Fixed dummy particles filling the kernel support behind each wall on the fluid's
+    /// lattice, with the generalised wall condition of Adami, Hu & Adams 2012: velocity
+    /// `−ũ` and pressure `(Σ p_f W + ρ g·Σ r_wf W)/Σ W` extrapolated from the fluid.
+    Dummy,
 }
 
 /// One periodic axis: positions wrap into `[min, max)`.

@@ -1,6 +1,7 @@
-//! Stages shared by every scheme: reordering, walls, neighbour search with the pair cache,
+//! Stages shared by every scheme: reordering, walls (mirror and dummy particles), neighbour search with the pair cache,
 //! free-surface detection.
 
+pub mod dummy;
 pub mod free_surface;
 pub mod neighbours;
 pub mod reorder;

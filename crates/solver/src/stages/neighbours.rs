@@ -7,18 +7,21 @@ use crate::stage::{Stage, StepContext, par_rows_mut};
 use crate::state::{Pair, State};
 
 /// Rebuilds the neighbour lists of the fluid particles at the current positions (their
-/// neighbours include boundary particles) and fills the pair cache (`r_ab`, `r²`,
+/// neighbours include boundary particles; dummy wall particles get rows too) and fills the pair cache (`r_ab`, `r²`,
 /// `W'(r)/r`).
 #[derive(Debug)]
 pub struct Neighbours<K: Kernel, const D: usize> {
     search: CellSearch<D>,
     kernel: Scaled<K, D>,
+    boundary_rows: bool,
 }
 
 impl<K: Kernel, const D: usize> Neighbours<K, D> {
-    /// A stage for `kernel` in `domain`; search radius = kernel support.
-    pub fn new(kernel: Scaled<K, D>, domain: crate::neighbours::Domain<D>) -> Self {
-        Self { search: CellSearch::new(kernel.support, domain), kernel }
+    /// A stage for `kernel` in `domain`; search radius = kernel support. With
+    /// `boundary_rows` the boundary particles get neighbour rows too (dummy walls
+    /// extrapolate from their fluid neighbours).
+    pub fn new(kernel: Scaled<K, D>, domain: crate::neighbours::Domain<D>, boundary_rows: bool) -> Self {
+        Self { search: CellSearch::new(kernel.support, domain), kernel, boundary_rows }
     }
 }
 
@@ -28,7 +31,8 @@ impl<K: Kernel, const D: usize> Stage<D> for Neighbours<K, D> {
     }
 
     fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
-        self.search.build_rows(&s.particles.x, s.particles.fluid, &mut s.neighbours);
+        let rows = if self.boundary_rows { s.particles.total() } else { s.particles.fluid };
+        self.search.build_rows(&s.particles.x, rows, &mut s.neighbours);
         let n_pairs = s.neighbours.pairs();
         s.pairs.resize(n_pairs, Pair::default());
         let (x, list, dom, k) = (&s.particles.x, &s.neighbours, s.domain, self.kernel);
