@@ -360,7 +360,8 @@ impl<const D: usize> Simulation<D> {
                     dt = dt.min(cfl * h / u);
                 }
                 let mu = self.scene.fluid.viscosity;
-                if mu > 0.0 {
+                let Scheme::Isph(opts) = &self.scene.scheme;
+                if mu > 0.0 && opts.viscosity == crate::scene::ViscousIntegration::Explicit {
                     dt = dt.min(viscous * self.state.density * h * h / mu);
                 }
                 let floor = 1e-9 * self.scene.time.end;

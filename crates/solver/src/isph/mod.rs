@@ -3,20 +3,22 @@
 //! The step, built from the scene (a stage the scene does not need is not built):
 //! `reorder` (locality) → `advect` (eq. 3) → `walls` (§2.4.2; mirror walls only) →
 //! `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation) →
-//! `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; μ > 0 only) → `body_force` (eq. 4;
-//! g ≠ 0 only) → `mirror_velocity` | `dummy_velocity` (walls only) → `ppe_assemble`
+//! `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
+//! (eq. 4; g ≠ 0 only) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
+//! `mirror_velocity` | `dummy_velocity` (walls only) → `ppe_assemble`
 //! (eqs. 10, 12) → `ppe_solve` (eq. 5) → `dummy_pressure` (dummy walls only) →
 //! `correction` (eqs. 6, 15) → `position` (eq. 7) → `shifting` (eqs. 20–21; when
 //! configured).
 
+pub mod implicit_viscosity;
 pub mod predictor;
 pub mod projection;
 pub mod shifting;
 
 use crate::kernel::{Kernel, Scaled};
 use crate::ppe::PpeSolve;
-use crate::scene::WallModel;
 use crate::scene::{IsphOptions, Scene, Shifting as ShiftSpec};
+use crate::scene::{ViscousIntegration, WallModel};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::{free_surface::FreeSurface, neighbours::Neighbours, reorder::Reorder, walls};
@@ -44,11 +46,18 @@ pub fn build_stages<K: Kernel, const D: usize>(
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Start)));
     }
     stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold }));
-    if scene.fluid.viscosity > 0.0 {
-        stages.push(Box::new(predictor::Viscosity { nu: scene.fluid.viscosity / scene.fluid.density }));
+    // Explicit: u* = uⁿ + Δt ν L(uⁿ), then + Δt g. Implicit: uⁿ + Δt g first, then the
+    // solve (the force inside it keeps the steady state exact).
+    let nu = scene.fluid.viscosity / scene.fluid.density;
+    let implicit = opts.viscosity == ViscousIntegration::Implicit;
+    if nu > 0.0 && !implicit {
+        stages.push(Box::new(predictor::Viscosity { nu }));
     }
     if g.norm_squared() > 0.0 {
         stages.push(Box::new(predictor::BodyForce { g }));
+    }
+    if nu > 0.0 && implicit {
+        stages.push(Box::new(implicit_viscosity::ImplicitViscosity::new(nu)));
     }
     match walls {
         Some(WallModel::Mirror) => stages.push(Box::new(walls::MirrorVelocity)),

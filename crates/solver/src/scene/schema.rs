@@ -262,6 +262,20 @@ pub struct IsphOptions {
     /// Form of the velocity divergence on the PPE right-hand side.
     #[serde(default)]
     pub divergence: Divergence,
+    /// Time integration of the viscous term.
+    #[serde(default)]
+    pub viscosity: ViscousIntegration,
+}
+
+/// Time integration of the viscous term of the predictor (Qiu 2013 eq. 4).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ViscousIntegration {
+    /// Forward Euler (Qiu): bound by the viscous limit `Δt ≤ α_d ρ h²/μ` (eq. 18).
+    #[default]
+    Explicit,
+    /// Backward Euler, one sparse solve per component; no viscous time-step limit.
+    Implicit,
 }
 
 /// Velocity-divergence operator of the PPE source term.
