@@ -45,7 +45,7 @@ impl NoiseBand {
         format!(
             "A metric counts as changed when it moved by more than {rel} % of its baseline value \
              and by more than {abs:e} in absolute terms. Lower is better for error metrics \
-             (name contains `err`) and drifts (name contains `drift`); other metrics and observed \
+             (name contains \"err\") and drifts (name contains \"drift\"); other metrics and observed \
              orders are only marked changed. Wall time is the ratio now / baseline, flagged when \
              it moved by more than {wall} %. Runs are matched by scheme, preset and dx.",
             rel = self.rel * 100.0,

@@ -119,6 +119,7 @@ fn marks_appear_in_summary_md_and_html() {
         "| isph-paper_dx0.02 | ok | 6.50 | 8.45 | **×1.30 (slower)** |",
         "check b error at dx=0.04 <= 1.8% (paper): **newly failing**",
         "Runs not in the baseline: isph-tuned_dx0.02.",
+        "| observed order | `b_rel_err_max` | 2.00 | 1.50 | -25.0 % | changed |",
     ] {
         assert!(md.contains(needle), "summary.md lacks {needle:?}:\n{md}");
     }

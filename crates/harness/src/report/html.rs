@@ -60,16 +60,64 @@ fn speed_class(w: &WallChange) -> &'static str {
     }
 }
 
-/// Rows `metric | baseline | now | change | mark` of a list of changes.
-fn change_rows(changes: &[MetricChange]) -> Markup {
+/// An observed order as text (`1.73`, `—`).
+pub fn format_order(v: Option<f64>) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.2}"),
+        Some(_) => "NaN".to_string(),
+        None => "—".to_string(),
+    }
+}
+
+/// A value that may have moved: the new value, and when it moved the baseline value and
+/// the relative change (`0.095 % (was 0.048 %, +100.0 %)`).
+fn moved_value(m: &MetricChange, fmt: impl Fn(Option<f64>) -> String) -> String {
+    match m.mark {
+        Mark::Unchanged => fmt(m.new),
+        _ => format!("{} (was {}, {})", fmt(m.new), fmt(m.old), format_change(m)),
+    }
+}
+
+/// Rows `name | value | mark` of the observed orders.
+fn order_rows(changes: &[MetricChange]) -> Markup {
     html! {
         @for m in changes {
             tr {
                 td class="l" { code { (m.name) } }
-                td { (format_metric(&m.name, m.old)) }
-                td { (format_metric(&m.name, m.new)) }
-                td { (format_change(m)) }
+                td { (moved_value(m, format_order)) }
                 td class=(mark_class(m.mark)) { (m.mark.label()) }
+            }
+        }
+    }
+}
+
+/// One table of every metric (rows) of every matched run (columns); a moved value shows
+/// its baseline and change and is coloured by its mark.
+fn metric_table(case: &CaseComparison) -> Markup {
+    let mut names: Vec<&str> = Vec::new();
+    for r in &case.runs {
+        for m in &r.metrics {
+            if !names.contains(&m.name.as_str()) {
+                names.push(&m.name);
+            }
+        }
+    }
+    names.sort_unstable();
+    html! {
+        table {
+            tr { th class="l" { "metric" } @for r in &case.runs { th { code { (r.slug) } } } }
+            @for n in &names {
+                tr {
+                    td class="l" { code { (n) } }
+                    @for r in &case.runs {
+                        @match r.metrics.iter().find(|m| m.name == *n) {
+                            Some(m) => td class=(mark_class(m.mark)) title=(m.mark.label()) {
+                                (moved_value(m, |v| format_metric(n, v)))
+                            },
+                            None => td { "—" },
+                        }
+                    }
+                }
             }
         }
     }
@@ -116,16 +164,14 @@ fn baseline_section(cmp: &Comparison, case: &CaseComparison) -> Markup {
         @if !case.orders.is_empty() {
             h3 { "Observed orders" }
             table {
-                tr { th class="l" { "metric" } th { "baseline" } th { "now" } th { "change" } th { "mark" } }
-                (change_rows(&case.orders))
+                tr { th class="l" { "metric" } th { "order (baseline, change)" } th { "mark" } }
+                (order_rows(&case.orders))
             }
         }
-        @for r in &case.runs {
-            h3 { "Metrics of " code { (r.slug) } }
-            table {
-                tr { th class="l" { "metric" } th { "baseline" } th { "now" } th { "change" } th { "mark" } }
-                (change_rows(&r.metrics))
-            }
+        @if !case.runs.is_empty() {
+            h3 { "Metrics" }
+            p class="note" { "Values now; a value that moved beyond the band shows its baseline and the change, green when better, red when worse, yellow when changed without a direction." }
+            (metric_table(case))
         }
     }
 }

@@ -3,7 +3,9 @@
 //! pass/fail), the failed checks below the table, and with a baseline the regressions
 //! and improvements beyond the noise band.
 
-use super::html::{format_change, format_metric, format_ratio, key_errors, key_order, resolutions};
+use super::html::{
+    format_change, format_metric, format_order, format_ratio, key_errors, key_order, resolutions,
+};
 use crate::baseline::{CaseComparison, Comparison, Mark};
 use crate::results::{CaseRecord, CaseResults, Summary};
 use std::fmt::Write;
@@ -122,11 +124,12 @@ fn write_case_comparison(md: &mut String, case: &CaseComparison) -> std::fmt::Re
         writeln!(md)?;
     }
     let moved = |m: Mark| m != Mark::Unchanged;
-    let rows: Vec<(String, &crate::baseline::MetricChange)> = case
+    // (run, change, whether it is an observed order)
+    let rows: Vec<(String, &crate::baseline::MetricChange, bool)> = case
         .runs
         .iter()
-        .flat_map(|r| r.metrics.iter().filter(|m| moved(m.mark)).map(move |m| (r.slug.clone(), m)))
-        .chain(case.orders.iter().filter(|m| moved(m.mark)).map(|m| ("observed order".to_string(), m)))
+        .flat_map(|r| r.metrics.iter().filter(|m| moved(m.mark)).map(move |m| (r.slug.clone(), m, false)))
+        .chain(case.orders.iter().filter(|m| moved(m.mark)).map(|m| ("observed order".to_string(), m, true)))
         .collect();
     let unchanged = case.tally().unchanged;
     if rows.is_empty() {
@@ -134,18 +137,19 @@ fn write_case_comparison(md: &mut String, case: &CaseComparison) -> std::fmt::Re
     } else {
         writeln!(md, "| run | metric | baseline | now | change | mark |")?;
         writeln!(md, "|---|---|---:|---:|---:|---|")?;
-        for (run, m) in &rows {
+        for (run, m, is_order) in &rows {
             let mark = match m.mark {
                 Mark::Worse | Mark::Better => format!("**{}**", m.mark.label()),
                 other => other.label().to_string(),
             };
+            let fmt = |v| if *is_order { format_order(v) } else { format_metric(&m.name, v) };
             writeln!(
                 md,
                 "| {} | `{}` | {} | {} | {} | {mark} |",
                 cell(run),
                 m.name,
-                format_metric(&m.name, m.old),
-                format_metric(&m.name, m.new),
+                fmt(m.old),
+                fmt(m.new),
                 format_change(m)
             )?;
         }
