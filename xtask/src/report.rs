@@ -1,5 +1,7 @@
-//! `cargo xtask report [--out DIR]`: re-render the report from existing results files.
+//! `cargo xtask report [--out DIR] [--baseline DIR]`: re-render the report from existing
+//! results files, optionally compared with a previous reports directory.
 
+use meniscus_harness::report::{Baseline, RenderOptions};
 use std::path::PathBuf;
 use std::process::ExitCode;
 
@@ -9,15 +11,31 @@ pub struct Args {
     /// Directory holding <case>/results.json [default: <workspace>/reports].
     #[arg(long, value_name = "DIR")]
     out: Option<PathBuf>,
+    /// A previous reports/ directory: mark every metric better / worse / unchanged against it
+    /// (in the HTML and summary.md).
+    #[arg(long, value_name = "DIR")]
+    baseline: Option<PathBuf>,
 }
 
-/// Re-renders every case page, summary.json and index.html.
+/// Re-renders every case page (of the cases in validation/), summary.json, summary.md and
+/// index.html.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
-    let out = args.out.unwrap_or_else(|| crate::workspace_root().join("reports"));
-    let results = meniscus_harness::report::render_all(&out)?;
-    if results.is_empty() {
+    let root = crate::workspace_root();
+    let out = args.out.unwrap_or_else(|| root.join("reports"));
+    let cases = meniscus_harness::validate::known_cases(&root.join("validation"))?;
+    let baseline = args.baseline.as_deref().map(|dir| Baseline::load(dir, Some(&cases))).transpose()?;
+    let rendered = meniscus_harness::report::render(&out, &RenderOptions { cases: Some(cases), baseline })?;
+    if rendered.results.is_empty() {
         anyhow::bail!("no <case>/results.json under {}: run `cargo xtask validate` first", out.display());
     }
-    eprintln!("rendered {} case(s) into {}", results.len(), out.join("index.html").display());
+    if let Some(cmp) = &rendered.comparison {
+        eprintln!("against baseline {}: {}", cmp.baseline.display(), cmp.tally().describe());
+    }
+    eprintln!(
+        "rendered {} case(s) into {} (summary: {})",
+        rendered.results.len(),
+        out.join("index.html").display(),
+        out.join("summary.md").display()
+    );
     Ok(ExitCode::SUCCESS)
 }

@@ -1,4 +1,5 @@
-//! `cargo xtask validate [--quick|--full] [--case NAME…] [--out DIR] [--force] [--jobs N]`.
+//! `cargo xtask validate [--quick|--full] [--case NAME…] [--out DIR] [--force] [--jobs N]
+//! [--baseline DIR]`.
 
 use anyhow::Context;
 use meniscus_harness::{Tier, ValidateOptions};
@@ -30,6 +31,10 @@ pub struct Args {
     /// No progress bars.
     #[arg(long)]
     no_progress: bool,
+    /// A previous reports/ directory: mark every metric better / worse / unchanged against it
+    /// (in the HTML and summary.md). The exit code still depends on the checks only.
+    #[arg(long, value_name = "DIR")]
+    baseline: Option<PathBuf>,
 }
 
 /// Runs the validation; the exit code is 0 only when every check passes.
@@ -51,6 +56,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         force: args.force,
         jobs: args.jobs.max(1),
         progress: !args.no_progress,
+        baseline: args.baseline,
     };
     let start = Instant::now();
     let outcome = meniscus_harness::validate(&opts).context("validation could not run")?;
@@ -64,12 +70,16 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             eprintln!("  FAIL {}: {value} (threshold {threshold}){note}", c.name);
         }
     }
+    if let Some(cmp) = &outcome.comparison {
+        eprintln!("against baseline {}: {}", cmp.baseline.display(), cmp.tally().describe());
+    }
     eprintln!(
-        "{} runs executed, {} cached, {:.1} s; report: {}",
+        "{} runs executed, {} cached, {:.1} s; report: {} (summary: {})",
         outcome.executed,
         outcome.reused,
         start.elapsed().as_secs_f64(),
-        opts.out.join("index.html").display()
+        opts.out.join("index.html").display(),
+        opts.out.join("summary.md").display()
     );
     Ok(if outcome.pass() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }

@@ -8,11 +8,14 @@
 //! `meniscus-reference` ([`metrics`]), fits observed orders ([`fit`]), evaluates the checks
 //! ([`checks`]) and writes `reports/<case>/results.json` and `reports/summary.json`
 //! ([`results`], DESIGN.md "Results files"). Plotting and HTML ([`report`]) is a separate
-//! pass that reads only JSON, so `cargo xtask report` re-renders without running anything.
+//! pass that reads only JSON, so `cargo xtask report` re-renders without running anything;
+//! it also writes `reports/summary.md`, and with a previous `reports/` directory as a
+//! baseline ([`baseline`]) marks what got better or worse beyond a stated noise band.
 //!
 //! The entry points used by `cargo xtask` are [`validate::validate`] and
 //! [`report::render_all`].
 
+pub mod baseline;
 pub mod cache;
 pub mod case;
 pub mod checks;

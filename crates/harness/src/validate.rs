@@ -1,6 +1,7 @@
 //! `cargo xtask validate`: run every case's sweep (reusing cached runs), compute metrics,
 //! orders and checks, write the results files and render the report.
 
+use crate::baseline::Comparison;
 use crate::cache::{self, RunRecord};
 use crate::case::{self, Case, Tier};
 use crate::checks::evaluate_all;
@@ -10,7 +11,7 @@ use crate::io;
 use crate::metrics;
 use crate::progress::Progress;
 use crate::provenance::Provenance;
-use crate::report;
+use crate::report::{self, Baseline, RenderOptions};
 use crate::results::{CaseRecord, CaseResults, Convergence, RunResult, Summary};
 use crate::sweep::{self, RunSpec};
 use std::collections::BTreeMap;
@@ -37,6 +38,8 @@ pub struct ValidateOptions {
     pub jobs: usize,
     /// Show progress bars.
     pub progress: bool,
+    /// A previous `reports/` directory to compare the new results with.
+    pub baseline: Option<PathBuf>,
 }
 
 /// What a validation produced.
@@ -48,6 +51,8 @@ pub struct Outcome {
     pub executed: usize,
     /// Runs taken from the cache.
     pub reused: usize,
+    /// The comparison with the baseline, when one was given.
+    pub comparison: Option<Comparison>,
 }
 
 impl Outcome {
@@ -57,13 +62,25 @@ impl Outcome {
     }
 }
 
+/// The names of the case files in `validation_dir` (their file stems), sorted.
+pub fn known_cases(validation_dir: &Path) -> Result<Vec<String>> {
+    Ok(case::discover(validation_dir, &[])?
+        .iter()
+        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .collect())
+}
+
 /// Runs the validation described by `opts`; failed checks are results, not errors.
 pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     let paths = case::discover(&opts.validation_dir, &opts.cases)?;
     let cases: Vec<Case> = paths.iter().map(|p| Case::load(p)).collect::<Result<_>>()?;
+    let known = known_cases(&opts.validation_dir)?;
+    // Read the baseline before running anything: a wrong path fails at once, and a baseline
+    // that is the output directory itself still holds the previous results.
+    let baseline = opts.baseline.as_deref().map(|dir| Baseline::load(dir, Some(&known))).transpose()?;
     let progress = Progress::new(opts.progress);
     let provenance = Provenance::collect(&opts.workspace);
-    let mut outcome = Outcome { results: Vec::new(), executed: 0, reused: 0 };
+    let mut outcome = Outcome { results: Vec::new(), executed: 0, reused: 0, comparison: None };
     for case in &cases {
         let specs = sweep::expand(case, opts.tier)?;
         let case_dir = opts.out.join(&case.case);
@@ -88,7 +105,8 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
         ));
         outcome.results.push(results);
     }
-    report::render_all(&opts.out)?;
+    let rendered = report::render(&opts.out, &RenderOptions { cases: Some(known), baseline })?;
+    outcome.comparison = rendered.comparison;
     Ok(outcome)
 }
 
@@ -339,6 +357,7 @@ mod tests {
             force: false,
             jobs: 1,
             progress: false,
+            baseline: None,
         };
         let first = validate(&opts).unwrap();
         assert_eq!((first.executed, first.reused), (1, 0));
@@ -349,14 +368,36 @@ mod tests {
         assert!(opts.out.join("tiny_drop/index.html").is_file());
         assert!(opts.out.join("summary.json").is_file());
         assert!(opts.out.join("index.html").is_file());
+        let md = std::fs::read_to_string(opts.out.join("summary.md")).unwrap();
+        assert!(md.contains("| tiny_drop | isph | quick | 0.1 |"), "{md}");
+        // A stale case directory (no case file) is left out of the index and summaries.
+        io::write_json(
+            &opts.out.join("stale_case/results.json"),
+            &CaseResults { case: "stale_case".into(), ..res.clone() },
+        )
+        .unwrap();
         let second = validate(&opts).unwrap();
         assert_eq!((second.executed, second.reused), (0, 1));
+        let index = std::fs::read_to_string(opts.out.join("index.html")).unwrap();
+        assert!(index.contains("tiny_drop/index.html") && !index.contains("stale_case"));
+        let summary: Summary = io::read_json(&opts.out.join("summary.json")).unwrap();
+        assert_eq!(summary.cases.len(), 1);
         assert_eq!(second.results[0].runs, first.results[0].runs);
         case.scene["time"]["end"] = serde_json::json!(0.0006);
         io::write_json(&vdir.join("tiny_drop.json"), &case).unwrap();
         let third = validate(&opts).unwrap();
         assert_eq!((third.executed, third.reused), (1, 0), "scene hash changed: rerun");
-        let forced = validate(&ValidateOptions { force: true, ..opts.clone() }).unwrap();
+        // The output directory as its own baseline: read before the rerun.
+        let forced =
+            validate(&ValidateOptions { force: true, baseline: Some(opts.out.clone()), ..opts.clone() })
+                .unwrap();
         assert_eq!(forced.executed, 1);
+        let cmp = forced.comparison.expect("a baseline was given");
+        assert!(cmp.cases[0].in_baseline && cmp.cases[0].runs.len() == 1);
+        assert!(cmp.case("stale_case").is_none());
+        let md = std::fs::read_to_string(opts.out.join("summary.md")).unwrap();
+        assert!(md.contains("## Compared with baseline"), "{md}");
+        let missing = ValidateOptions { baseline: Some(dir.path().join("nowhere")), ..opts.clone() };
+        assert!(validate(&missing).is_err(), "a baseline without results is an error");
     }
 }

@@ -1,6 +1,7 @@
 //! HTML pages (maud): self-contained (inline CSS, no scripts, figures by relative link).
 
 use super::FigureFile;
+use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
 use crate::results::{CaseRecord, CaseResults, RunResult, Summary};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
@@ -8,7 +9,9 @@ const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:12
 table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}\
 th{background:#f0f0f0}td.l,th.l{text-align:left}.pass{background:#d9f2d9;color:#145214}\
 .fail{background:#f8d7d7;color:#7a1010}pre{background:#f6f6f6;padding:1em;overflow-x:auto;font-size:85%}\
-figure{display:inline-block;margin:0.5em}figcaption{font-size:90%;color:#555}code{font-size:90%}";
+figure{display:inline-block;margin:0.5em}figcaption{font-size:90%;color:#555}code{font-size:90%}\
+.better{background:#d9f2d9;color:#145214}.worse{background:#f8d7d7;color:#7a1010}\
+.changed{background:#fff3cd;color:#664d03}.note{color:#555;font-size:90%}";
 
 /// Formats a metric: relative errors and drifts in percent, counts as integers.
 pub fn format_metric(name: &str, v: Option<f64>) -> String {
@@ -18,6 +21,158 @@ pub fn format_metric(name: &str, v: Option<f64>) -> String {
         Some(x) if name.contains("rel_err") || name.contains("drift") => format!("{:.3} %", x * 100.0),
         Some(x) if x.fract().abs() < 1e-12 && x.abs() < 1e15 => format!("{x:.0}"),
         Some(x) => format!("{x:.4e}"),
+    }
+}
+
+/// The change of a metric as text: `+12.3 %` of the baseline, or `—` when undefined.
+pub fn format_change(m: &MetricChange) -> String {
+    match m.relative() {
+        Some(r) => format!("{:+.1} %", r * 100.0),
+        None => "—".to_string(),
+    }
+}
+
+/// A wall-time ratio as text: `×1.31 (slower)`, `×0.95`.
+pub fn format_ratio(w: &WallChange) -> String {
+    let flag = match w.flag {
+        Some(Speed::Slower) => " (slower)",
+        Some(Speed::Faster) => " (faster)",
+        None => "",
+    };
+    if w.ratio.is_finite() { format!("×{:.2}{flag}", w.ratio) } else { "—".to_string() }
+}
+
+/// CSS class of a mark (`better`, `worse`, `changed`, or none).
+fn mark_class(m: Mark) -> &'static str {
+    match m {
+        Mark::Better => "better",
+        Mark::Worse => "worse",
+        Mark::Changed | Mark::Added | Mark::Removed => "changed",
+        Mark::Unchanged => "",
+    }
+}
+
+fn speed_class(w: &WallChange) -> &'static str {
+    match w.flag {
+        Some(Speed::Slower) => "worse",
+        Some(Speed::Faster) => "better",
+        None => "",
+    }
+}
+
+/// An observed order as text (`1.73`, `—`).
+pub fn format_order(v: Option<f64>) -> String {
+    match v {
+        Some(x) if x.is_finite() => format!("{x:.2}"),
+        Some(_) => "NaN".to_string(),
+        None => "—".to_string(),
+    }
+}
+
+/// A value that may have moved: the new value, and when it moved the baseline value and
+/// the relative change (`0.095 % (was 0.048 %, +100.0 %)`).
+fn moved_value(m: &MetricChange, fmt: impl Fn(Option<f64>) -> String) -> String {
+    match m.mark {
+        Mark::Unchanged => fmt(m.new),
+        _ => format!("{} (was {}, {})", fmt(m.new), fmt(m.old), format_change(m)),
+    }
+}
+
+/// Rows `name | value | mark` of the observed orders.
+fn order_rows(changes: &[MetricChange]) -> Markup {
+    html! {
+        @for m in changes {
+            tr {
+                td class="l" { code { (m.name) } }
+                td { (moved_value(m, format_order)) }
+                td class=(mark_class(m.mark)) { (m.mark.label()) }
+            }
+        }
+    }
+}
+
+/// One table of every metric (rows) of every matched run (columns); a moved value shows
+/// its baseline and change and is coloured by its mark.
+fn metric_table(case: &CaseComparison) -> Markup {
+    let mut names: Vec<&str> = Vec::new();
+    for r in &case.runs {
+        for m in &r.metrics {
+            if !names.contains(&m.name.as_str()) {
+                names.push(&m.name);
+            }
+        }
+    }
+    names.sort_unstable();
+    html! {
+        table {
+            tr { th class="l" { "metric" } @for r in &case.runs { th { code { (r.slug) } } } }
+            @for n in &names {
+                tr {
+                    td class="l" { code { (n) } }
+                    @for r in &case.runs {
+                        @match r.metrics.iter().find(|m| m.name == *n) {
+                            Some(m) => td class=(mark_class(m.mark)) title=(m.mark.label()) {
+                                (moved_value(m, |v| format_metric(n, v)))
+                            },
+                            None => td { "—" },
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The "Compared with baseline" section of a case page.
+fn baseline_section(cmp: &Comparison, case: &CaseComparison) -> Markup {
+    html! {
+        h2 { "Compared with baseline" }
+        p { "Baseline " code { (cmp.baseline.display()) } ": " (case.tally().describe()) "." }
+        p class="note" { (cmp.band.describe()) }
+        @if !case.in_baseline { p class="changed" { "This case is not in the baseline." } }
+        @if !case.added_runs.is_empty() { p { "Runs not in the baseline: " (case.added_runs.join(", ")) } }
+        @if !case.removed_runs.is_empty() { p { "Baseline runs not run now: " (case.removed_runs.join(", ")) } }
+        @if !case.checks.is_empty() {
+            h3 { "Checks whose outcome changed" }
+            table {
+                tr { th class="l" { "check" } th class="l" { "change" } }
+                @for c in &case.checks {
+                    tr {
+                        td class="l" { (c.name) }
+                        td class=(if c.newly_failing() { "l worse" } else if c.newly_passing() { "l better" } else { "l changed" }) { (c.label()) }
+                    }
+                }
+            }
+        }
+        @if !case.runs.is_empty() {
+            h3 { "Wall time" }
+            table {
+                tr { th class="l" { "run" } th class="l" { "status (baseline → now)" } th { "baseline [s]" } th { "now [s]" } th { "ratio" } }
+                @for r in &case.runs {
+                    tr {
+                        td class="l" { code { (r.slug) } }
+                        td class=(format!("l {}", mark_class(r.status))) {
+                            @if r.old_status == r.new_status { (r.new_status) } @else { (r.old_status) " → " (r.new_status) }
+                        }
+                        td { (format!("{:.2}", r.wall.old)) }
+                        td { (format!("{:.2}", r.wall.new)) }
+                        td class=(speed_class(&r.wall)) { (format_ratio(&r.wall)) }
+                    }
+                }
+            }
+        }
+        @if !case.orders.is_empty() {
+            h3 { "Observed orders" }
+            table {
+                tr { th class="l" { "metric" } th { "order (baseline, change)" } th { "mark" } }
+                (order_rows(&case.orders))
+            }
+        }
+        @if !case.runs.is_empty() {
+            h3 { "Metrics" }
+            p class="note" { "Values now; a value that moved beyond the band shows its baseline and the change, green when better, red when worse, yellow when changed without a direction." }
+            (metric_table(case))
+        }
     }
 }
 
@@ -57,15 +212,21 @@ fn metric_columns(results: &CaseResults, record: Option<&CaseRecord>) -> Vec<Str
 }
 
 /// Distinct spacings, coarse to fine, as text.
-fn resolutions(runs: &[RunResult]) -> String {
+pub(crate) fn resolutions(runs: &[RunResult]) -> String {
     let mut dx: Vec<f64> = runs.iter().map(|r| r.dx).collect();
     dx.sort_by(|a, b| b.total_cmp(a));
     dx.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
     dx.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")
 }
 
-/// The page of one case.
-pub fn case_page(results: &CaseResults, record: Option<&CaseRecord>, figures: &[FigureFile]) -> String {
+/// The page of one case; with a comparison, a "Compared with baseline" section follows the
+/// checks.
+pub fn case_page(
+    results: &CaseResults,
+    record: Option<&CaseRecord>,
+    figures: &[FigureFile],
+    comparison: Option<&Comparison>,
+) -> String {
     let columns = metric_columns(results, record);
     let (passed, failed) = results.counts();
     let case = record.map(|r| &r.case);
@@ -95,6 +256,9 @@ pub fn case_page(results: &CaseResults, record: Option<&CaseRecord>, figures: &[
                     td class="l" { (c.note.as_deref().unwrap_or("")) }
                 }
             }
+        }
+        @if let Some(cmp) = comparison {
+            @if let Some(case) = cmp.case(&results.case) { (baseline_section(cmp, case)) }
         }
         h2 { "Errors" }
         table {
@@ -180,7 +344,7 @@ pub fn case_page(results: &CaseResults, record: Option<&CaseRecord>, figures: &[
 
 /// Key errors of a case for the index: each key metric at the finest completed run of the
 /// primary preset.
-fn key_errors(results: &CaseResults, record: Option<&CaseRecord>) -> String {
+pub(crate) fn key_errors(results: &CaseResults, record: Option<&CaseRecord>) -> String {
     let keys: Vec<String> = record.map(|r| r.case.key_metrics.clone()).unwrap_or_default();
     let primary = record
         .map(|r| r.case.primary_preset().to_string())
@@ -202,7 +366,7 @@ fn key_errors(results: &CaseResults, record: Option<&CaseRecord>) -> String {
 }
 
 /// The order shown on the index: the first convergence metric of the case.
-fn key_order(results: &CaseResults, record: Option<&CaseRecord>) -> String {
+pub(crate) fn key_order(results: &CaseResults, record: Option<&CaseRecord>) -> String {
     let first = record
         .and_then(|r| r.case.convergence.iter().find(|m| results.convergence.contains_key(*m)).cloned())
         .or_else(|| results.convergence.keys().next().cloned());
@@ -212,17 +376,46 @@ fn key_order(results: &CaseResults, record: Option<&CaseRecord>) -> String {
     }
 }
 
-/// `reports/index.html`: one row per case.
-pub fn index_page(results: &[CaseResults], records: &[Option<&CaseRecord>], summary: &Summary) -> String {
+/// The "vs baseline" cell of the index: the case's tally, coloured by whether it regressed.
+fn baseline_cell(case: Option<&CaseComparison>) -> Markup {
+    match case {
+        None => html! { td class="l" { "—" } },
+        Some(c) if !c.in_baseline => html! { td class="l changed" { "not in baseline" } },
+        Some(c) => {
+            let t = c.tally();
+            let class = if t.regressed() {
+                "l worse"
+            } else if t.better + t.faster + t.newly_passing > 0 {
+                "l better"
+            } else {
+                "l"
+            };
+            html! { td class=(class) { (t.describe()) } }
+        }
+    }
+}
+
+/// `reports/index.html`: one row per case; with a comparison, a "vs baseline" column.
+pub fn index_page(
+    results: &[CaseResults],
+    records: &[Option<&CaseRecord>],
+    summary: &Summary,
+    comparison: Option<&Comparison>,
+) -> String {
     let body = html! {
         h1 { "Meniscus validation" }
         p class=(if summary.pass { "pass" } else { "fail" }) {
             (summary.passed) " / " (summary.passed + summary.failed) " checks passed over " (results.len()) " cases"
         }
+        @if let Some(cmp) = comparison {
+            p { "Compared with baseline " code { (cmp.baseline.display()) } ": " (cmp.tally().describe()) "." }
+            p class="note" { (cmp.band.describe()) }
+        }
         table {
             tr {
                 th class="l" { "case" } th class="l" { "scheme" } th class="l" { "tier" } th class="l" { "resolutions (dx)" }
                 th class="l" { "key errors" } th class="l" { "observed order" } th { "wall [s]" } th { "checks" } th { "result" }
+                @if comparison.is_some() { th class="l" { "vs baseline" } }
             }
             @for (i, r) in results.iter().enumerate() {
                 @let rec = records.get(i).copied().flatten();
@@ -237,6 +430,7 @@ pub fn index_page(results: &[CaseResults], records: &[Option<&CaseRecord>], summ
                     td { (format!("{:.1}", r.runs.iter().map(|x| x.wall_s).sum::<f64>())) }
                     td { (passed) " / " (passed + failed) }
                     (pass_cell(failed == 0))
+                    @if let Some(cmp) = comparison { (baseline_cell(cmp.case(&r.case))) }
                 }
             }
         }

@@ -1,17 +1,21 @@
 //! The report: SVG figures ([`plots`]) and self-contained HTML pages ([`html`]), rendered
 //! from the JSON in the output directory only (`cargo xtask report` runs nothing).
 //!
-//! Layout: `reports/index.html` (one row per case), `reports/summary.json`, and per case
+//! Layout: `reports/index.html` (one row per case), `reports/summary.json`,
+//! `reports/summary.md` ([`markdown`], for CI job summaries), and per case
 //! `reports/<case>/index.html` with its figures `reports/<case>/*.svg` (relative links).
+//! With a baseline ([`crate::baseline`]), the pages and `summary.md` also show what moved.
 
 pub mod html;
+pub mod markdown;
 pub mod plots;
 
+use crate::baseline::{self, Comparison, NoiseBand};
 use crate::case::Figure;
 use crate::error::Result;
 use crate::io;
 use crate::results::{CaseRecord, CaseResults, RunResult};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// A figure written next to a case page.
 #[derive(Debug, Clone, PartialEq)]
@@ -23,11 +27,13 @@ pub struct FigureFile {
 }
 
 /// Renders the figures and the page of one case into `case_dir`; `record` (the case file
-/// and provenance) supplies the figure list, parameters, errata and provenance when present.
+/// and provenance) supplies the figure list, parameters, errata and provenance when present;
+/// `comparison` adds the "Compared with baseline" section.
 pub fn render_case(
     case_dir: &Path,
     results: &CaseResults,
     record: Option<&CaseRecord>,
+    comparison: Option<&Comparison>,
 ) -> Result<Vec<FigureFile>> {
     let mut figures = Vec::new();
     let runs: Vec<&RunResult> = results.runs.iter().collect();
@@ -63,7 +69,7 @@ pub fn render_case(
             }
         }
     }
-    let page = html::case_page(results, record, &figures);
+    let page = html::case_page(results, record, &figures, comparison);
     io::write_atomic(&case_dir.join("index.html"), page.as_bytes())?;
     Ok(figures)
 }
@@ -92,10 +98,21 @@ fn per_preset(
 
 /// Every `<out>/<case>/results.json` present, sorted by case name.
 pub fn collect(out: &Path) -> Result<Vec<(CaseResults, Option<CaseRecord>)>> {
+    collect_cases(out, None)
+}
+
+/// Like [`collect`], restricted to the directories named in `cases` when given (other
+/// directories, e.g. a stale case or `work_precision/`, are not even read).
+pub fn collect_cases(out: &Path, cases: Option<&[String]>) -> Result<Vec<(CaseResults, Option<CaseRecord>)>> {
     let mut found = Vec::new();
     let Ok(rd) = std::fs::read_dir(out) else { return Ok(found) };
-    let mut dirs: Vec<_> =
-        rd.filter_map(|e| e.ok().map(|e| e.path())).filter(|p| p.join("results.json").is_file()).collect();
+    let wanted = |p: &Path| {
+        cases.is_none_or(|names| p.file_name().is_some_and(|n| names.iter().any(|c| n == c.as_str())))
+    };
+    let mut dirs: Vec<_> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| wanted(p) && p.join("results.json").is_file())
+        .collect();
     dirs.sort();
     for d in dirs {
         let results: CaseResults = io::read_json(&d.join("results.json"))?;
@@ -105,20 +122,65 @@ pub fn collect(out: &Path) -> Result<Vec<(CaseResults, Option<CaseRecord>)>> {
     Ok(found)
 }
 
+/// A loaded baseline: the directory and the results found there.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Baseline {
+    /// The previous `reports/` directory.
+    pub dir: PathBuf,
+    /// Its results files.
+    pub results: Vec<CaseResults>,
+}
+
+impl Baseline {
+    /// Reads `dir` (see [`baseline::load`]); an empty directory is an error.
+    pub fn load(dir: &Path, cases: Option<&[String]>) -> Result<Self> {
+        Ok(Baseline { dir: dir.to_path_buf(), results: baseline::load(dir, cases)? })
+    }
+}
+
+/// What [`render`] renders besides the results.
+#[derive(Debug, Clone, Default)]
+pub struct RenderOptions {
+    /// Render only these cases (the case files of `validation/`); every
+    /// `<out>/<case>/results.json` when `None`.
+    pub cases: Option<Vec<String>>,
+    /// Compare with this baseline.
+    pub baseline: Option<Baseline>,
+}
+
+/// What [`render`] produced.
+#[derive(Debug, Clone)]
+pub struct Rendered {
+    /// The results rendered, sorted by case name.
+    pub results: Vec<CaseResults>,
+    /// The comparison with the baseline, when one was given.
+    pub comparison: Option<Comparison>,
+}
+
 /// Re-renders every case page, `summary.json` and `index.html` in `out` from the results
 /// files there; returns the results found.
 pub fn render_all(out: &Path) -> Result<Vec<CaseResults>> {
-    let found = collect(out)?;
-    for (results, record) in &found {
-        render_case(&out.join(&results.case), results, record.as_ref())?;
-    }
+    Ok(render(out, &RenderOptions::default())?.results)
+}
+
+/// Renders every case page, `summary.json`, `summary.md` and `index.html` in `out` from the
+/// results files there (restricted to `opts.cases`), compared with `opts.baseline`.
+pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
+    let found = collect_cases(out, opts.cases.as_deref())?;
     let results: Vec<CaseResults> = found.iter().map(|f| f.0.clone()).collect();
+    let comparison =
+        opts.baseline.as_ref().map(|b| baseline::compare(&b.dir, &results, &b.results, NoiseBand::default()));
+    for (results, record) in &found {
+        render_case(&out.join(&results.case), results, record.as_ref(), comparison.as_ref())?;
+    }
     let summary = crate::validate::summary_of(&results);
     io::write_json(&out.join("summary.json"), &summary)?;
     let records: Vec<Option<&CaseRecord>> = found.iter().map(|f| f.1.as_ref()).collect();
-    let page = html::index_page(&results, &records, &summary);
+    let page = html::index_page(&results, &records, &summary, comparison.as_ref());
     io::write_atomic(&out.join("index.html"), page.as_bytes())?;
-    Ok(results)
+    let md = markdown::summary(&results, &records, &summary, comparison.as_ref());
+    io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
+    Ok(Rendered { results, comparison })
 }
 
 #[cfg(test)]
@@ -232,7 +294,7 @@ mod tests {
     fn renders_without_a_provenance_record() {
         let dir = Scratch::new("report-bare");
         let results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
-        let figs = render_case(dir.path(), &results, None).unwrap();
+        let figs = render_case(dir.path(), &results, None, None).unwrap();
         assert!(figs.is_empty());
         let page = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
         assert!(page.contains("isph-paper_dx0.04"));

@@ -1,0 +1,183 @@
+//! `reports/summary.md`: the report in GitHub-flavoured Markdown, for a CI job summary or
+//! a pull-request comment. One row per case (key errors, observed order, wall time,
+//! pass/fail), the failed checks below the table, and with a baseline the regressions
+//! and improvements beyond the noise band.
+
+use super::html::{
+    format_change, format_metric, format_order, format_ratio, key_errors, key_order, resolutions,
+};
+use crate::baseline::{CaseComparison, Comparison, Mark};
+use crate::results::{CaseRecord, CaseResults, Summary};
+use std::fmt::Write;
+
+/// Makes `text` safe inside a table cell (no pipes, no line breaks).
+fn cell(text: &str) -> String {
+    text.replace('|', "\\|").replace(['\n', '\r'], " ")
+}
+
+/// The whole `summary.md`. `records[i]` belongs to `results[i]`.
+pub fn summary(
+    results: &[CaseResults],
+    records: &[Option<&CaseRecord>],
+    summary: &Summary,
+    comparison: Option<&Comparison>,
+) -> String {
+    let mut md = String::new();
+    // Writing to a String cannot fail.
+    let _ = write_summary(&mut md, results, records, summary, comparison);
+    md
+}
+
+fn write_summary(
+    md: &mut String,
+    results: &[CaseResults],
+    records: &[Option<&CaseRecord>],
+    summary: &Summary,
+    comparison: Option<&Comparison>,
+) -> std::fmt::Result {
+    writeln!(md, "# Meniscus validation\n")?;
+    writeln!(
+        md,
+        "**{}**: {} / {} checks passed over {} case(s).\n",
+        if summary.pass { "PASS" } else { "FAIL" },
+        summary.passed,
+        summary.passed + summary.failed,
+        results.len()
+    )?;
+    let with_baseline = comparison.is_some();
+    write!(md, "| case | scheme | tier | dx | key errors | observed order | wall [s] | checks | result |")?;
+    writeln!(md, "{}", if with_baseline { " vs baseline |" } else { "" })?;
+    write!(md, "|---|---|---|---|---|---|---:|---:|---|")?;
+    writeln!(md, "{}", if with_baseline { "---|" } else { "" })?;
+    for (i, r) in results.iter().enumerate() {
+        let rec = records.get(i).copied().flatten();
+        let (passed, failed) = r.counts();
+        write!(
+            md,
+            "| {} | {} | {} | {} | {} | {} | {:.1} | {} / {} | {} |",
+            cell(&r.case),
+            cell(&r.scheme),
+            cell(&r.tier),
+            resolutions(&r.runs),
+            cell(&key_errors(r, rec)),
+            cell(&key_order(r, rec)),
+            r.runs.iter().map(|x| x.wall_s).sum::<f64>(),
+            passed,
+            passed + failed,
+            if failed == 0 { "PASS" } else { "FAIL" }
+        )?;
+        if let Some(cmp) = comparison {
+            let text = match cmp.case(&r.case) {
+                Some(c) if c.in_baseline => c.tally().describe(),
+                Some(_) => "not in baseline".to_string(),
+                None => "—".to_string(),
+            };
+            write!(md, " {} |", cell(&text))?;
+        }
+        writeln!(md)?;
+    }
+    writeln!(md, "\n## Failed checks\n")?;
+    let mut any = false;
+    for r in results {
+        for c in r.checks.iter().filter(|c| !c.pass) {
+            any = true;
+            let value = c.value.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
+            let threshold = c.threshold.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
+            let note = c.note.as_deref().map(|n| format!(" — {n}")).unwrap_or_default();
+            writeln!(md, "- `{}`: {}: value {value}, threshold {threshold}{note}", r.case, c.name)?;
+        }
+    }
+    if !any {
+        writeln!(md, "None.")?;
+    }
+    if let Some(cmp) = comparison {
+        write_comparison(md, cmp)?;
+    }
+    Ok(())
+}
+
+fn write_comparison(md: &mut String, cmp: &Comparison) -> std::fmt::Result {
+    writeln!(md, "\n## Compared with baseline `{}`\n", cmp.baseline.display())?;
+    writeln!(md, "{}\n", cmp.band.describe())?;
+    writeln!(md, "Overall: {}.", cmp.tally().describe())?;
+    for case in &cmp.cases {
+        write_case_comparison(md, case)?;
+    }
+    Ok(())
+}
+
+fn write_case_comparison(md: &mut String, case: &CaseComparison) -> std::fmt::Result {
+    writeln!(md, "\n### {}\n", case.case)?;
+    if !case.in_baseline {
+        return writeln!(md, "Not in the baseline.");
+    }
+    if !case.added_runs.is_empty() {
+        writeln!(md, "Runs not in the baseline: {}.\n", case.added_runs.join(", "))?;
+    }
+    if !case.removed_runs.is_empty() {
+        writeln!(md, "Baseline runs not run now: {}.\n", case.removed_runs.join(", "))?;
+    }
+    for c in &case.checks {
+        writeln!(md, "- check {}: **{}**", c.name, c.label())?;
+    }
+    if !case.checks.is_empty() {
+        writeln!(md)?;
+    }
+    let moved = |m: Mark| m != Mark::Unchanged;
+    // (run, change, whether it is an observed order)
+    let rows: Vec<(String, &crate::baseline::MetricChange, bool)> = case
+        .runs
+        .iter()
+        .flat_map(|r| r.metrics.iter().filter(|m| moved(m.mark)).map(move |m| (r.slug.clone(), m, false)))
+        .chain(case.orders.iter().filter(|m| moved(m.mark)).map(|m| ("observed order".to_string(), m, true)))
+        .collect();
+    let unchanged = case.tally().unchanged;
+    if rows.is_empty() {
+        writeln!(md, "Every metric within the noise band ({unchanged} compared).\n")?;
+    } else {
+        writeln!(md, "| run | metric | baseline | now | change | mark |")?;
+        writeln!(md, "|---|---|---:|---:|---:|---|")?;
+        for (run, m, is_order) in &rows {
+            let mark = match m.mark {
+                Mark::Worse | Mark::Better => format!("**{}**", m.mark.label()),
+                other => other.label().to_string(),
+            };
+            let fmt = |v| if *is_order { format_order(v) } else { format_metric(&m.name, v) };
+            writeln!(
+                md,
+                "| {} | `{}` | {} | {} | {} | {mark} |",
+                cell(run),
+                m.name,
+                fmt(m.old),
+                fmt(m.new),
+                format_change(m)
+            )?;
+        }
+        writeln!(md, "\n{unchanged} other metric(s) within the noise band.\n")?;
+    }
+    if !case.runs.is_empty() {
+        writeln!(md, "| run | status | wall baseline [s] | wall now [s] | ratio |")?;
+        writeln!(md, "|---|---|---:|---:|---|")?;
+        for r in &case.runs {
+            let status = if r.old_status == r.new_status {
+                r.new_status.clone()
+            } else {
+                format!("{} → {} (**{}**)", r.old_status, r.new_status, r.status.label())
+            };
+            writeln!(
+                md,
+                "| {} | {} | {:.2} | {:.2} | {} |",
+                r.slug,
+                cell(&status),
+                r.wall.old,
+                r.wall.new,
+                if r.wall.flag.is_some() {
+                    format!("**{}**", format_ratio(&r.wall))
+                } else {
+                    format_ratio(&r.wall)
+                }
+            )?;
+        }
+    }
+    Ok(())
+}
