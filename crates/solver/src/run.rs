@@ -135,12 +135,12 @@ impl NeighbourBand {
             if r2 > 0 && (r2 as f64).sqrt() <= r * (1.0 + 1e-9) {
                 bulk += 1;
             }
-            for k in 0..D {
-                if idx[k] < n {
-                    idx[k] += 1;
+            for i in idx.iter_mut() {
+                if *i < n {
+                    *i += 1;
                     continue 'all;
                 }
-                idx[k] = -n;
+                *i = -n;
             }
             break;
         }
