@@ -101,7 +101,7 @@ pub enum Cause {
     },
     /// The pressure Poisson solver did not converge.
     #[error(
-        "PPE solver {solver} did not converge: relative residual {residual:.3e} after {iterations} iterations (raise scheme.isph.ppe.max_iterations or reduce the time step)"
+        "PPE solver {solver} did not converge: relative residual {residual:.3e} after {iterations} iterations (scheme.isph.ppe.max_iterations); a solver that needed far fewer iterations in earlier steps points to a degenerated particle distribution"
     )]
     PpeNoConvergence {
         /// Solver name.

@@ -199,10 +199,28 @@ fn base() -> Value {
     v
 }
 
-/// The (coarse) DESIGN scene with 1–3 edits, each at a node chosen by `picks` (fractions of the
-/// node count, so shrinking keeps them in range).
-fn mutate(picks: &[(f64, Edit)]) -> Value {
+/// A 3D variant of the base scene: a ball of 268 particles with a box next to it.
+fn base_3d() -> Value {
     let mut v = base();
+    v["dimension"] = json!(3);
+    v["body_force"] = json!([0.0, 0.0, -9.81]);
+    v["bodies"] = json!([
+        {"role": "fluid", "shape": {"sphere": {"center": [0.0, 0.0, 0.0], "radius": 0.2}},
+         "velocity": {"affine": {"gradient": [[-1.0, 0.0, 0.0], [0.0, 0.5, 0.0], [0.0, 0.0, 0.5]],
+                                 "offset": [0.0, 0.0, 0.0]}}},
+        {"role": "fluid", "shape": {"box": {"min": [0.3, 0.0, 0.0], "max": [0.5, 0.2, 0.2]}},
+         "pressure": {"hydrostatic": {"surface_point": [0.0, 0.0, 0.2]}}}
+    ]);
+    v["scheme"]["isph"]["free_surface_threshold"] = json!(2.4);
+    v["probes"] =
+        json!([{"kinetic_energy": {}}, {"momentum": {}}, {"pressure_at": {"point": [0.0, 0.0, 0.0]}}]);
+    v
+}
+
+/// The (coarse) DESIGN scene, or its 3D variant, with 1–3 edits, each at a node chosen by
+/// `picks` (fractions of the node count, so shrinking keeps them in range).
+fn mutate(three_d: bool, picks: &[(f64, Edit)]) -> Value {
+    let mut v = if three_d { base_3d() } else { base() };
     for (pick, e) in picks {
         let mut all = Vec::new();
         paths(&v, &mut Vec::new(), &mut all);
@@ -339,8 +357,11 @@ proptest! {
     /// or size (huge, negative, zero, out of range, empty arrays, wrong dimensions),
     /// removed, or given an extra key or element.
     #[test]
-    fn mutated_design_scene_never_panics(picks in prop::collection::vec((0.0..1.0f64, edit()), 1..4)) {
-        exercise(&text_of(&mutate(&picks)));
+    fn mutated_design_scene_never_panics(
+        three_d in prop::bool::weighted(0.25),
+        picks in prop::collection::vec((0.0..1.0f64, edit()), 1..4),
+    ) {
+        exercise(&text_of(&mutate(three_d, &picks)));
     }
 
     /// Arbitrary JSON (mostly objects with the schema's keys).
@@ -349,10 +370,10 @@ proptest! {
         exercise(&text_of(&v));
     }
 
-    /// Number-only mutations of every numeric leaf of the DESIGN scene.
+    /// Number-only mutations of every numeric leaf of the DESIGN scene (or its 3D variant).
     #[test]
-    fn numeric_edge_values_never_panic(pick in 0.0..1.0f64, x in number()) {
-        let mut v = base();
+    fn numeric_edge_values_never_panic(three_d in prop::bool::weighted(0.25), pick in 0.0..1.0f64, x in number()) {
+        let mut v = if three_d { base_3d() } else { base() };
         let mut all = Vec::new();
         paths(&v, &mut Vec::new(), &mut all);
         all.retain(|p| {
@@ -375,6 +396,7 @@ fn exercise_runs_a_valid_scene() {
     let scene = Scene::from_json(&v.to_string()).expect("valid");
     assert!(estimate(&scene) < MAX_BUILT);
     assert_eq!(exercise(&v.to_string()), Reached::Ran);
+    assert_eq!(exercise(&base_3d().to_string()), Reached::Ran);
     assert_eq!(exercise("{}"), Reached::Rejected);
     v["dx"] = json!(0.001);
     assert_eq!(exercise(&v.to_string()), Reached::TooLarge);
