@@ -110,10 +110,11 @@ pub struct Simulation<const D: usize> {
 
 /// The upper bound of the neighbour-count guard.
 ///
-/// A particle of the initial lattice has `bulk` neighbours within the kernel support
-/// (the lattice points `z Δx`, `z ∈ ℤ^D \ {0}`, with |z| Δx up to the support, the shell on
-/// the support included as rounding may put it inside: 28 for h = 1.5 Δx in 2D). In an incompressible flow the particle number density
-/// stays near its initial value, so a fluid particle with more than `4 × bulk` neighbours
+/// A particle of the initial lattice has `bulk` neighbours within the kernel support: the
+/// lattice points `z Δx`, `z ∈ ℤ^D \ {0}`, with `|z| Δx` up to the support (the shell on the
+/// support included, as rounding may put it inside): 28 for h = 1.5 Δx in 2D. In an
+/// incompressible flow the particle number density stays near its initial value, so a
+/// fluid particle with more than `4 × bulk` neighbours
 /// means the local spacing has shrunk to half of Δx in 2D (0.63 Δx in 3D): particles are
 /// clumping or penetrating each other, which precedes a blow-up (and makes the neighbour
 /// lists grow without bound). Zero neighbours is allowed: an isolated splash particle.
