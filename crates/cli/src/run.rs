@@ -34,8 +34,9 @@ impl Observer for CliObserver {
 pub fn write_json_atomic(path: &Path, value: &impl serde::Serialize) -> anyhow::Result<()> {
     let tmp = path.with_extension("json.tmp");
     std::fs::write(&tmp, serde_json::to_vec_pretty(value)?)
-        .with_context(|| format!("writing {}", tmp.display()))?;
-    std::fs::rename(&tmp, path).with_context(|| format!("renaming to {}", path.display()))?;
+        .with_context(|| format!("cannot write `{}` (through `{}`)", path.display(), tmp.display()))?;
+    std::fs::rename(&tmp, path)
+        .with_context(|| format!("cannot rename `{}` to `{}`", tmp.display(), path.display()))?;
     Ok(())
 }
 
@@ -56,10 +57,10 @@ pub fn run(
         }
         rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("starting the thread pool")?;
     }
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    writable_dir(out)?;
     let frames = (scene.output.vtk_every > 0).then(|| out.join("frames"));
     if let Some(dir) = &frames {
-        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        writable_dir(dir)?;
     }
     let mut sim = AnySimulation::new(&scene)?;
     let bar = ProgressBar::new(1000);
@@ -88,10 +89,37 @@ pub fn run(
         s.threads,
         out.display()
     );
-    match &report.error {
-        None => Ok(()),
-        Some(e) => Err(Diverged(e.to_string()).into()),
+    let Some(e) = &report.error else { return Ok(()) };
+    let last_good = match (&obs.frames, &report.last_good) {
+        (Some(dir), Some(frame)) => {
+            let path = vtk::write_frame_as(dir, "last_good", frame)?;
+            format!("the particles at the start of step {} are in {}", frame.step + 1, path.display())
+        }
+        _ => "rerun with --vtk-every N to get the particles before the failing step in \
+              frames/last_good.vtu"
+            .to_string(),
+    };
+    Err(Diverged(format!(
+        "{e}\n  {last_good}\n  probes and summary up to the divergence are in {}",
+        out.display()
+    ))
+    .into())
+}
+
+/// Creates `dir` if needed and checks that files can be created in it, so that a bad
+/// output path fails before the run rather than after it.
+fn writable_dir(dir: &Path) -> anyhow::Result<()> {
+    if dir.exists() && !dir.is_dir() {
+        anyhow::bail!("the output directory `{}` exists and is not a directory", dir.display());
     }
+    std::fs::create_dir_all(dir)
+        .with_context(|| format!("cannot create the output directory `{}`", dir.display()))?;
+    let probe = dir.join(".meniscus-write-test");
+    std::fs::write(&probe, b"ok")
+        .with_context(|| format!("cannot write to the output directory `{}`", dir.display()))?;
+    std::fs::remove_file(&probe)
+        .with_context(|| format!("cannot remove `{}` from the output directory", probe.display()))?;
+    Ok(())
 }
 
 /// `meniscus check SCENE`.

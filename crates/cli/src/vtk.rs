@@ -12,6 +12,11 @@ use vtkio::model::{
 
 /// Writes `frame` to `dir/frame_<step>.vtu` atomically (temporary file, then rename).
 pub fn write_frame(dir: &Path, frame: &Frame) -> anyhow::Result<PathBuf> {
+    write_frame_as(dir, &format!("frame_{:06}", frame.step), frame)
+}
+
+/// Writes `frame` to `dir/<stem>.vtu` atomically (temporary file, then rename).
+pub fn write_frame_as(dir: &Path, stem: &str, frame: &Frame) -> anyhow::Result<PathBuf> {
     let n = frame.x.len();
     let points: Vec<f64> = frame.x.iter().flatten().copied().collect();
     let velocity: Vec<f64> = frame.u.iter().flatten().copied().collect();
@@ -41,8 +46,8 @@ pub fn write_frame(dir: &Path, frame: &Frame) -> anyhow::Result<PathBuf> {
         data: DataSet::inline(piece),
         file_path: None,
     };
-    let path = dir.join(format!("frame_{:06}.vtu", frame.step));
-    let tmp = dir.join(format!(".frame_{:06}.tmp.vtu", frame.step));
+    let path = dir.join(format!("{stem}.vtu"));
+    let tmp = dir.join(format!(".{stem}.tmp.vtu"));
     vtk.export(&tmp).with_context(|| format!("writing {}", tmp.display()))?;
     std::fs::rename(&tmp, &path).with_context(|| format!("renaming to {}", path.display()))?;
     Ok(path)

@@ -46,27 +46,62 @@ impl SceneError {
 }
 
 /// What tripped a guard.
+///
+/// Every variant names the particle (by its id: the index in the initial particle order,
+/// as in the VTK frames) and, for the end-of-step guards, how many other particles tripped
+/// the same check, so that a user can find the spot in `frames/last_good.vtu`.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum Cause {
     /// A position, velocity or pressure became NaN or infinite.
-    #[error("non-finite {quantity} at particle {particle}")]
+    #[error("particle {particle} has a non-finite {quantity}{}", others_note(*others))]
     NonFinite {
         /// `position`, `velocity` or `pressure`.
         quantity: &'static str,
         /// Particle id (index in the initial particle order).
         particle: usize,
+        /// Number of other particles with a non-finite value at the same step.
+        others: usize,
     },
     /// A particle left the region around the initial bounding box.
-    #[error("particle {particle} escaped to {position:?}")]
+    #[error(
+        "particle {particle} escaped to {} m, outside the guard box {} .. {} m (the initial bounding box enlarged by 4 times its size){}",
+        point(position), point(lo), point(hi), others_note(*others)
+    )]
     Escape {
         /// Particle id.
         particle: usize,
         /// Its position \[m\].
         position: Vec<f64>,
+        /// Lower corner of the guard box \[m\].
+        lo: Vec<f64>,
+        /// Upper corner of the guard box \[m\].
+        hi: Vec<f64>,
+        /// Number of other particles outside the box at the same step.
+        others: usize,
+    },
+    /// A fluid particle has far more neighbours than a particle of the initial lattice:
+    /// particles clumped together (pressure collapse, particle penetration).
+    #[error(
+        "particle {particle} at {} m has {count} neighbours, more than the limit {limit} (4 times the {bulk} of a particle of the initial lattice): particles are clumping{}",
+        point(position), others_note(*others)
+    )]
+    Clumping {
+        /// Particle id.
+        particle: usize,
+        /// Its position \[m\].
+        position: Vec<f64>,
+        /// Its neighbour count (particles within the kernel support).
+        count: usize,
+        /// The largest count allowed.
+        limit: usize,
+        /// Neighbour count of a particle inside the initial lattice.
+        bulk: usize,
+        /// Number of other particles over the limit at the same step.
+        others: usize,
     },
     /// The pressure Poisson solver did not converge.
     #[error(
-        "PPE solver {solver} did not converge: relative residual {residual:.3e} after {iterations} iterations"
+        "PPE solver {solver} did not converge: relative residual {residual:.3e} after {iterations} iterations (scheme.isph.ppe.max_iterations); a solver that needed far fewer iterations in earlier steps points to a degenerated particle distribution"
     )]
     PpeNoConvergence {
         /// Solver name.
@@ -85,7 +120,9 @@ pub enum Cause {
         reason: String,
     },
     /// The adaptive time step fell below its floor.
-    #[error("time step {dt:.3e} s below the floor {floor:.3e} s")]
+    #[error(
+        "time step {dt:.3e} s fell below the floor {floor:.3e} s (1e-9 of time.end): the flow is too fast or too viscous for the adaptive step"
+    )]
     DtFloor {
         /// The step \[s\].
         dt: f64,
@@ -94,9 +131,27 @@ pub enum Cause {
     },
 }
 
+/// `(x, y)` with four significant digits.
+fn point(v: &[f64]) -> String {
+    let parts: Vec<String> = v.iter().map(|x| format!("{x:.4e}")).collect();
+    format!("({})", parts.join(", "))
+}
+
+/// ` (and N other particles)` when N > 0.
+fn others_note(others: usize) -> String {
+    match others {
+        0 => String::new(),
+        1 => " (and 1 other particle)".to_string(),
+        n => format!(" (and {n} other particles)"),
+    }
+}
+
 /// A run that went unstable: the stage, step and time where a guard tripped, and why.
+///
+/// Displayed as `diverged at step 812 (t = 4.210e-3 s) in stage `guard`: particle 5123
+/// escaped to …`; the step is the one being taken, the time the time at its start.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[error("diverged in stage `{stage}` at step {step} (t = {time:.6e} s): {cause}")]
+#[error("diverged at step {step} (t = {time:.4e} s) in stage `{stage}`: {cause}")]
 pub struct SolverError {
     /// Stage that tripped (or `guard` for the end-of-step checks).
     pub stage: &'static str,

@@ -150,7 +150,16 @@ impl<const D: usize> CellSearch<D> {
                 Some((a, b)) => (b - a) / self.radius,
                 None => (hi[k] - lo[k]) / self.radius + 1.0,
             })
-            .map(|c| if c.is_finite() { c.max(1.0) } else { 1.0 })
+            // An extent beyond f64 (particles ~1e308 m apart) counts as the largest one.
+            .map(|c| {
+                if c.is_finite() {
+                    c.max(1.0)
+                } else if c.is_nan() {
+                    1.0
+                } else {
+                    f64::MAX
+                }
+            })
             .product();
         let limit = (MAX_CELLS_PER_PARTICLE * x.len().max(1)) as f64;
         let scale = if extent > limit { (extent / limit).powf(1.0 / D as f64) } else { 1.0 };
@@ -166,7 +175,22 @@ impl<const D: usize> CellSearch<D> {
                 let span = if (hi[k] - lo[k]).is_finite() { hi[k] - lo[k] } else { 0.0 };
                 self.origin[k] = if lo[k].is_finite() { lo[k] } else { 0.0 };
                 self.cell_size[k] = size;
-                self.dims[k] = ((span / size).floor() as usize + 1).max(1);
+                self.dims[k] = ((span / size).floor().min(limit) as usize).saturating_add(1);
+            }
+        }
+        // A spread along one axis only (one particle flung far away) still exceeds the cap
+        // after the isotropic scaling: shrink the longest axis. Particles beyond the last
+        // cell are clamped into it, which keeps every pair within the radius in adjacent
+        // cells (the search stays correct); periodic axes get wider cells instead.
+        loop {
+            let total: f64 = self.dims.iter().map(|&d| d as f64).product();
+            if total <= limit {
+                break;
+            }
+            let k = (0..D).max_by_key(|&k| self.dims[k]).unwrap_or(0);
+            self.dims[k] = ((self.dims[k] as f64 * limit / total).floor() as usize).max(1);
+            if let Some((a, b)) = self.domain.periodic[k] {
+                self.cell_size[k] = (b - a) / self.dims[k] as f64;
             }
         }
         let ncells: usize = self.dims.iter().product();

@@ -82,6 +82,9 @@ pub struct RunReport {
     pub final_frame: Frame,
     /// The divergence, if the run did not reach its end time.
     pub error: Option<SolverError>,
+    /// When the run diverged: the particles at the start of the failing step (the last
+    /// state that passed every guard), for `frames/last_good.vtu`.
+    pub last_good: Option<Frame>,
 }
 
 impl RunReport {
@@ -102,6 +105,59 @@ pub struct Simulation<const D: usize> {
     stages: Vec<Box<dyn Stage<D>>>,
     probes: ProbeSet<D>,
     bounds: (Vector<D>, Vector<D>),
+    neighbour_band: NeighbourBand,
+    last_good: LastGood<D>,
+}
+
+/// The upper bound of the neighbour-count guard.
+///
+/// A particle of the initial lattice has `bulk` neighbours within the kernel support: the
+/// lattice points `z Δx`, `z ∈ ℤ^D \ {0}`, with `|z| Δx` up to the support (the shell on the
+/// support included, as rounding may put it inside): 28 for h = 1.5 Δx in 2D. In an
+/// incompressible flow the particle number density stays near its initial value, so a
+/// fluid particle with more than `4 × bulk` neighbours
+/// means the local spacing has shrunk to half of Δx in 2D (0.63 Δx in 3D): particles are
+/// clumping or penetrating each other, which precedes a blow-up (and makes the neighbour
+/// lists grow without bound). Zero neighbours is allowed: an isolated splash particle.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+struct NeighbourBand {
+    bulk: usize,
+    limit: usize,
+}
+
+impl NeighbourBand {
+    /// The band for kernel `support` \[m\] on a lattice of spacing `dx` in D dimensions.
+    fn new<const D: usize>(support: f64, dx: f64) -> Self {
+        let r = support / dx;
+        let n = r.ceil() as i64;
+        let mut bulk = 0usize;
+        let mut idx = [-n; D];
+        'all: loop {
+            let r2: i64 = idx.iter().map(|i| i * i).sum();
+            if r2 > 0 && (r2 as f64).sqrt() <= r * (1.0 + 1e-9) {
+                bulk += 1;
+            }
+            for i in idx.iter_mut() {
+                if *i < n {
+                    *i += 1;
+                    continue 'all;
+                }
+                *i = -n;
+            }
+            break;
+        }
+        Self { bulk, limit: 4 * bulk.max(1) }
+    }
+}
+
+/// The particles at the start of the current step, copied into reused buffers (no
+/// allocation once warm): what [`RunReport::last_good`] shows when a step fails.
+#[derive(Debug, Clone, Default)]
+struct LastGood<const D: usize> {
+    step: usize,
+    time: f64,
+    particles: Particles<D>,
+    free_surface: Vec<bool>,
 }
 
 /// A simulation of either dimension.
@@ -158,7 +214,9 @@ impl<const D: usize> Simulation<D> {
     pub fn new(scene: &Scene) -> Result<Self, SceneError> {
         let g = Vector::<D>::from_fn(|i, _| scene.body_force.get(i).copied().unwrap_or(0.0));
         let mut particles = Particles::<D>::default();
+        let mut body_start = Vec::with_capacity(scene.bodies.len());
         for (i, body) in scene.bodies.iter().enumerate() {
+            body_start.push(particles.x.len());
             if body.role == Role::Wall {
                 return Err(SceneError::new(
                     format!("bodies[{i}].role"),
@@ -194,6 +252,7 @@ impl<const D: usize> Simulation<D> {
         for x in &mut particles.x {
             domain.wrap(x);
         }
+        check_seeds(&particles, &body_start, scene.dx, domain)?;
         if scene.boundaries.wall_model == WallModel::Dummy && !scene.boundaries.walls.is_empty() {
             let depth = 2.0 * scene.h();
             for x in dummy_layers(&scene.boundaries.walls, &domain, &particles.x, scene.dx, depth) {
@@ -232,12 +291,15 @@ impl<const D: usize> Simulation<D> {
             KernelKind::CubicSpline => build::<CubicSpline, D>(scene, h, domain),
             KernelKind::WendlandC2 => build::<WendlandC2, D>(scene, h, domain),
         };
+        let neighbour_band = NeighbourBand::new::<D>(weight.support, scene.dx);
         Ok(Self {
             scene: scene.clone(),
             state,
             stages,
             probes: ProbeSet::new(&scene.probes, weight, scene.dx, domain),
             bounds,
+            neighbour_band,
+            last_good: LastGood::default(),
         })
     }
 
@@ -278,6 +340,7 @@ impl<const D: usize> Simulation<D> {
         let targets = self.scene.output.probe_times.clone();
         let mut next = targets.iter().take_while(|&&s| s <= 0.0).count();
         while t < t_end * (1.0 - 1e-12) {
+            self.keep_last_good(step, t);
             let stop = targets.get(next).copied().filter(|&s| s < t_end).unwrap_or(t_end);
             let dt = match self.time_step(stop - t) {
                 Ok(dt) => dt,
@@ -344,7 +407,8 @@ impl<const D: usize> Simulation<D> {
             threads,
             ppe_iterations_mean: ppe_iters as f64 / step.max(1) as f64,
         };
-        RunReport { summary, probes: record, final_frame: self.frame(step, t), error }
+        let last_good = error.as_ref().map(|_| self.last_good_frame());
+        RunReport { summary, probes: record, final_frame: self.frame(step, t), error, last_good }
     }
 
     /// Δt of the next step, never past `remaining` (the time to the end or to the next
@@ -375,59 +439,173 @@ impl<const D: usize> Simulation<D> {
         Ok(if remaining <= dt * (1.0 + 1e-9) { remaining } else { dt })
     }
 
-    /// End-of-step checks: finite values, no particle escaped.
+    /// End-of-step checks, in this order of precedence: every position, velocity and
+    /// pressure is finite; no particle left the guard box (the initial bounding box
+    /// enlarged by four times its size); no fluid particle has more neighbours than the
+    /// [`NeighbourBand`] allows. The cause names the lowest particle id that failed the
+    /// most severe check and how many others failed it too.
     fn guard(&self) -> Result<(), Cause> {
+        use rayon::prelude::*;
         let p = &self.state.particles;
         let (lo, hi) = &self.bounds;
-        let bad = |a: usize| -> Option<Cause> {
+        let list = &self.state.neighbours;
+        // Rows 0..fluid are the fluid's (dummy walls add rows after them).
+        let counted = list.len() >= p.len();
+        let limit = self.neighbour_band.limit;
+        // Severity of particle a's failure (0 = none), most severe first.
+        let severity = |a: usize| -> u8 {
             if !p.x[a].iter().all(|v| v.is_finite()) {
-                return Some(Cause::NonFinite { quantity: "position", particle: p.id[a] as usize });
+                5
+            } else if !p.u[a].iter().all(|v| v.is_finite()) {
+                4
+            } else if !p.p[a].is_finite() {
+                3
+            } else if (0..D).any(|k| p.x[a][k] < lo[k] || p.x[a][k] > hi[k]) {
+                2
+            } else if counted && list.of(a).len() > limit {
+                1
+            } else {
+                0
             }
-            if !p.u[a].iter().all(|v| v.is_finite()) {
-                return Some(Cause::NonFinite { quantity: "velocity", particle: p.id[a] as usize });
-            }
-            if !p.p[a].is_finite() {
-                return Some(Cause::NonFinite { quantity: "pressure", particle: p.id[a] as usize });
-            }
-            if (0..D).any(|k| p.x[a][k] < lo[k] || p.x[a][k] > hi[k]) {
-                return Some(Cause::Escape {
-                    particle: p.id[a] as usize,
-                    position: p.x[a].iter().copied().collect(),
-                });
-            }
-            None
         };
-        use rayon::prelude::*;
-        let first = (0..p.len()).into_par_iter().filter(|&a| bad(a).is_some()).min_by_key(|&a| p.id[a]);
-        match first.and_then(bad) {
-            Some(c) => Err(c),
-            None => Ok(()),
+        // (severity, id of the first particle, particles with that severity)
+        let worst =
+            (0..p.len()).into_par_iter().map(|a| (severity(a), p.id[a], 1usize)).filter(|w| w.0 > 0).reduce(
+                || (0, u32::MAX, 0),
+                |x, y| match x.0.cmp(&y.0) {
+                    std::cmp::Ordering::Greater => x,
+                    std::cmp::Ordering::Less => y,
+                    std::cmp::Ordering::Equal => (x.0, x.1.min(y.1), x.2 + y.2),
+                },
+            );
+        let (level, id, n) = worst;
+        if level == 0 {
+            return Ok(());
         }
+        let a = (0..p.len()).find(|&a| p.id[a] == id).unwrap_or(0);
+        let (particle, others) = (id as usize, n - 1);
+        let vec = |v: &Vector<D>| v.iter().copied().collect::<Vec<f64>>();
+        Err(match level {
+            5 => Cause::NonFinite { quantity: "position", particle, others },
+            4 => Cause::NonFinite { quantity: "velocity", particle, others },
+            3 => Cause::NonFinite { quantity: "pressure", particle, others },
+            2 => Cause::Escape { particle, position: vec(&p.x[a]), lo: vec(lo), hi: vec(hi), others },
+            _ => Cause::Clumping {
+                particle,
+                position: vec(&p.x[a]),
+                count: list.of(a).len(),
+                limit,
+                bulk: self.neighbour_band.bulk,
+                others,
+            },
+        })
+    }
+
+    /// Copies the particles into the last-good buffers (called before every step).
+    fn keep_last_good(&mut self, step: usize, time: f64) {
+        let (keep, p) = (&mut self.last_good, &self.state.particles);
+        keep.step = step;
+        keep.time = time;
+        // The fluid only (boundary particles are rebuilt or extrapolated every step).
+        let nf = p.fluid;
+        keep.particles.fluid = nf;
+        keep.particles.id.clone_from(&p.id);
+        for (dst, src) in [(&mut keep.particles.x, &p.x), (&mut keep.particles.u, &p.u)] {
+            dst.clear();
+            dst.extend_from_slice(&src[..nf]);
+        }
+        keep.particles.p.clear();
+        keep.particles.p.extend_from_slice(&p.p[..nf]);
+        keep.free_surface.clone_from(&self.state.free_surface);
+    }
+
+    /// The particles at the start of the step being taken (the last state that passed
+    /// every guard), in initial-id order.
+    fn last_good_frame(&self) -> Frame {
+        let k = &self.last_good;
+        frame_of(&k.particles, &k.free_surface, k.step, k.time)
     }
 
     /// The particles in initial-id order.
     pub fn frame(&self, step: usize, time: f64) -> Frame {
-        let p = &self.state.particles;
-        let n = p.len();
-        let mut f = Frame {
-            step,
-            time,
-            x: vec![[0.0; 3]; n],
-            u: vec![[0.0; 3]; n],
-            p: vec![0.0; n],
-            free_surface: vec![false; n],
-        };
-        for a in 0..n {
-            let i = p.id[a] as usize;
-            for k in 0..D.min(3) {
-                f.x[i][k] = p.x[a][k];
-                f.u[i][k] = p.u[a][k];
-            }
-            f.p[i] = p.p[a];
-            f.free_surface[i] = self.state.free_surface.get(a).copied().unwrap_or(false);
-        }
-        f
+        frame_of(&self.state.particles, &self.state.free_surface, step, time)
     }
+}
+
+/// `particles` (with their free-surface flags) in initial-id order.
+fn frame_of<const D: usize>(p: &Particles<D>, free_surface: &[bool], step: usize, time: f64) -> Frame {
+    let n = p.len();
+    let mut f = Frame {
+        step,
+        time,
+        x: vec![[0.0; 3]; n],
+        u: vec![[0.0; 3]; n],
+        p: vec![0.0; n],
+        free_surface: vec![false; n],
+    };
+    for a in 0..n {
+        let i = p.id[a] as usize;
+        for k in 0..D.min(3) {
+            f.x[i][k] = p.x[a][k];
+            f.u[i][k] = p.u[a][k];
+        }
+        f.p[i] = p.p[a];
+        f.free_surface[i] = free_surface.get(a).copied().unwrap_or(false);
+    }
+    f
+}
+
+/// Rejects initial particles that cannot be run: a non-finite initial velocity or pressure
+/// (an affine or quadratic field overflowing), and particles closer than Δx/2 to each other
+/// (overlapping bodies). `body_start[i]` is the index of body i's first particle.
+fn check_seeds<const D: usize>(
+    p: &Particles<D>,
+    body_start: &[usize],
+    dx: f64,
+    domain: Domain<D>,
+) -> Result<(), SceneError> {
+    let body_of = |a: usize| body_start.partition_point(|&s| s <= a).saturating_sub(1);
+    let show = |v: &Vector<D>| {
+        let parts: Vec<String> = v.iter().map(|x| format!("{x:.4e}")).collect();
+        format!("({})", parts.join(", "))
+    };
+    if let Some(a) = (0..p.len()).find(|&a| !p.u[a].iter().all(|v| v.is_finite())) {
+        return Err(SceneError::new(
+            format!("bodies[{}].velocity", body_of(a)),
+            format!("u = {} at x = {}", show(&p.u[a]), show(&p.x[a])),
+            "must give a finite initial velocity at every particle",
+        ));
+    }
+    if let Some(a) = (0..p.len()).find(|&a| !p.p[a].is_finite()) {
+        return Err(SceneError::new(
+            format!("bodies[{}].pressure", body_of(a)),
+            format!("p = {} at x = {}", p.p[a], show(&p.x[a])),
+            "must give a finite initial pressure at every particle",
+        ));
+    }
+    let mut list = crate::neighbours::NeighbourList::default();
+    crate::neighbours::CellSearch::new(0.5 * dx, domain).build(&p.x, &mut list);
+    let close = (0..p.len()).flat_map(|a| list.of(a).iter().map(move |&b| (a, b as usize)));
+    // The pair whose later body comes first: that body is the one that overlaps.
+    if let Some((a, b)) = close.min_by_key(|&(a, b)| (body_of(a.max(b)), a.max(b), a.min(b))) {
+        let (i, j) = (body_of(a.max(b)), body_of(a.min(b)));
+        let x = show(&p.x[a.max(b)]);
+        return Err(if i == j {
+            SceneError::new(
+                format!("bodies[{i}].shape"),
+                format!("particles at {x}"),
+                "places particles closer than dx/2 to each other (the shape wraps onto itself \
+                 across a periodic boundary)",
+            )
+        } else {
+            SceneError::new(
+                format!("bodies[{i}].shape"),
+                format!("a particle at {x}"),
+                format!("overlaps bodies[{j}] (particles closer than dx/2); bodies must not overlap"),
+            )
+        });
+    }
+    Ok(())
 }
 
 fn build<K: Kernel, const D: usize>(
@@ -440,4 +618,78 @@ fn build<K: Kernel, const D: usize>(
         Scheme::Isph(opts) => crate::isph::build_stages::<K, D>(scene, opts, kernel, domain),
     };
     (stages, Weight { w: Box::new(move |r| kernel.w(r)), support: kernel.support })
+}
+
+#[cfg(test)]
+mod guard_tests {
+    use super::*;
+
+    fn small_drop() -> Simulation<2> {
+        let text = include_str!("../../../validation/scenes/elliptical_drop.json");
+        let mut scene = Scene::from_json(text).expect("DESIGN scene");
+        scene.dx = 0.1;
+        Simulation::<2>::new(&scene).expect("builds")
+    }
+
+    #[test]
+    fn bulk_neighbour_count_of_the_lattice() {
+        // Lattice points within 3 Δx (cubic spline, h = 1.5 Δx): |z|² ∈ {1, 2, 4, 5, 8, 9}.
+        assert_eq!(NeighbourBand::new::<2>(3.0, 1.0), NeighbourBand { bulk: 28, limit: 112 });
+        assert_eq!(NeighbourBand::new::<2>(0.3, 0.1).bulk, 28);
+        // h = Δx: |z|² ∈ {1, 2, 4} in 2D; in 3D |z|² ∈ {1, 2, 3, 4}: 6 + 12 + 8 + 6.
+        assert_eq!(NeighbourBand::new::<2>(2.0, 1.0).bulk, 12);
+        assert_eq!(NeighbourBand::new::<3>(2.0, 1.0).bulk, 32);
+    }
+
+    /// Runs the neighbour-search stage of a simulation.
+    fn search_neighbours(sim: &mut Simulation<2>, ctx: &StepContext) -> Result<(), Cause> {
+        let stage = sim.stages.iter_mut().find(|s| s.name() == "neighbours").expect("a neighbour stage");
+        stage.run(&mut sim.state, ctx)
+    }
+
+    #[test]
+    fn clumped_particles_trip_the_neighbour_guard() {
+        let mut sim = small_drop();
+        let ctx = StepContext { step: 1, time: 0.0, dt: 1e-5 };
+        search_neighbours(&mut sim, &ctx).expect("neighbour search");
+        assert_eq!(sim.guard(), Ok(()), "the initial lattice is within the band");
+        // Squeeze the drop to a third of its size: every interior particle now has about
+        // 9 × 28 neighbours.
+        for x in &mut sim.state.particles.x {
+            *x /= 3.0;
+        }
+        search_neighbours(&mut sim, &ctx).expect("neighbour search");
+        let cause = sim.guard().expect_err("clumping must trip the guard");
+        let Cause::Clumping { count, limit, bulk, others, .. } = &cause else { panic!("{cause}") };
+        assert!(count > limit && *limit == 112 && *bulk == 28 && *others > 10, "{cause}");
+        let msg = cause.to_string();
+        assert!(msg.contains("neighbours") && msg.contains("clumping"), "{msg}");
+    }
+
+    #[test]
+    fn guard_reports_the_most_severe_failure_with_the_lowest_id() {
+        let mut sim = small_drop();
+        let ctx = StepContext { step: 1, time: 0.0, dt: 1e-5 };
+        search_neighbours(&mut sim, &ctx).expect("neighbour search");
+        let n = sim.state.particles.len();
+        let at = |sim: &Simulation<2>, id: u32| sim.state.particles.id.iter().position(|&i| i == id).unwrap();
+        let (a, b, c) = (at(&sim, 7), at(&sim, 3), at(&sim, (n - 1) as u32));
+        sim.state.particles.x[a][0] = 1e6;
+        sim.state.particles.x[b][1] = -1e6;
+        sim.state.particles.p[c] = f64::NAN;
+        match sim.guard() {
+            Err(Cause::NonFinite { quantity: "pressure", particle, others: 0 }) => {
+                assert_eq!(particle, n - 1)
+            }
+            other => panic!("{other:?}"),
+        }
+        sim.state.particles.p[c] = 0.0;
+        let cause = sim.guard().expect_err("escape");
+        assert!(matches!(cause, Cause::Escape { particle: 3, others: 1, .. }), "{cause}");
+        let msg = cause.to_string();
+        assert!(
+            msg.starts_with("particle 3 escaped to (") && msg.contains("(and 1 other particle)"),
+            "{msg}"
+        );
+    }
 }

@@ -18,9 +18,29 @@ fn a_time_step_far_beyond_the_cfl_limit_diverges_with_a_named_cause() {
     assert!(report.summary.error.as_deref().is_some_and(|m| m.contains("step")));
     assert!(err.step >= 1 && err.time < 0.008);
     assert!(
-        matches!(err.cause, Cause::Escape { .. } | Cause::NonFinite { .. } | Cause::PpeNoConvergence { .. }),
+        matches!(
+            err.cause,
+            Cause::Escape { .. }
+                | Cause::NonFinite { .. }
+                | Cause::Clumping { .. }
+                | Cause::PpeNoConvergence { .. }
+        ),
         "{err}"
     );
+    // The message names the step, the time, the stage and the particle.
+    let msg = err.to_string();
+    assert!(msg.starts_with(&format!("diverged at step {} (t = ", err.step)), "{msg}");
+    assert!(msg.contains(&format!("in stage `{}`", err.stage)), "{msg}");
+    if err.stage == "guard" {
+        assert!(msg.contains("particle "), "{msg}");
+    }
+    // The last good state is the start of the failing step: finite, one particle per id.
+    let good = report.last_good.as_ref().expect("a diverged run keeps its last good state");
+    assert_eq!(good.step, report.summary.steps);
+    assert_eq!(good.step + 1, err.step);
+    assert!((good.time - err.time).abs() <= 1e-15);
+    assert_eq!(good.x.len(), report.summary.particles);
+    assert!(good.x.iter().chain(&good.u).flatten().chain(&good.p).all(|v| v.is_finite()));
     // The probes recorded before the divergence are kept, one sample per finished step.
     assert_eq!(report.probes.t.len(), report.summary.steps + 1);
     assert!(report.probes.get("kinetic_energy", "e").is_some_and(|e| e.iter().all(|v| v.is_finite())));
@@ -34,6 +54,7 @@ fn adaptive_time_step_respects_qiu_limits_and_reaches_the_end() {
     });
     let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
     assert!(report.error.is_none(), "{:?}", report.error);
+    assert!(report.last_good.is_none(), "only a diverged run has a last good state");
     assert!((report.summary.t_end - 0.008).abs() < 1e-12);
     // dt <= 0.2 h / u_max with u_max >= 100 m/s gives at least 0.008 / 1.2e-4 steps.
     assert!(report.summary.steps >= 67, "{} steps", report.summary.steps);

@@ -101,7 +101,7 @@ fn dummy_walls_match_mirror_walls() {
 
 #[test]
 fn a_channel_at_rest_stays_at_rest() {
-    let report = meniscus::run(&scene(&channel(10, 0.0, 2000.0, "bicgstab")), &mut meniscus::Quiet)
+    let report = meniscus::run(&scene(&channel(20, 0.0, 2000.0, "bicgstab")), &mut meniscus::Quiet)
         .expect("scene builds");
     assert!(report.error.is_none(), "{:?}", report.error);
     let e = report.final_frame.u.iter().map(|u| u[0].abs().max(u[1].abs())).fold(0.0, f64::max);
@@ -113,7 +113,7 @@ fn krylov_and_direct_solvers_agree_with_mirrors() {
     // The mirrors make duplicate columns (a particle and its source's mirror); the direct
     // factorisation must sum them as the Krylov products do.
     let run = |solver: &str| {
-        let mut v = channel(10, 6e-8, 3000.0, solver);
+        let mut v = channel(20, 6e-8, 3000.0, solver);
         v["output"]["probe_times"] = json!([]);
         let r = meniscus::run(&scene(&v), &mut meniscus::Quiet).expect("scene builds");
         assert!(r.error.is_none(), "{solver}: {:?}", r.error);
@@ -177,7 +177,7 @@ fn corner_particles_are_mirrored_twice() {
 
 #[test]
 fn wall_and_profile_errors_name_the_field() {
-    let mut base = channel(10, 0.0, 100.0, "cg");
+    let mut base = channel(20, 0.0, 100.0, "cg");
     base["output"]["probe_times"] = json!([]);
     type Edit = Box<dyn Fn(&mut Value)>;
     let cases: Vec<(Edit, &str)> = vec![

@@ -29,7 +29,7 @@ pub fn lattice_points<const D: usize>(shape: &Shape, dx: f64) -> Vec<SVector<f64
             let n = (radius / dx).ceil() as i64 + 1;
             let r2 = radius * radius * (1.0 + EDGE_TOL);
             let mut out = Vec::new();
-            for_each_index::<D>(-n - 1, n, |idx| {
+            for_each_index::<D>([-n - 1; D], [n; D], |idx| {
                 let x = c + SVector::<f64, D>::from_fn(|k, _| (idx[k] as f64 + 0.5) * dx);
                 if (x - c).norm_squared() <= r2 {
                     out.push(x);
@@ -43,12 +43,12 @@ pub fn lattice_points<const D: usize>(shape: &Shape, dx: f64) -> Vec<SVector<f64
             let c = (lo + hi) * 0.5;
             let counts: [i64; D] = std::array::from_fn(|k| ((hi[k] - lo[k]) / dx + EDGE_TOL).floor() as i64);
             let mut out = Vec::new();
-            for_each_index::<D>(0, counts.iter().copied().max().unwrap_or(0) - 1, |idx| {
-                if (0..D).all(|k| idx[k] < counts[k]) {
-                    out.push(SVector::<f64, D>::from_fn(|k, _| {
-                        c[k] + (idx[k] as f64 - 0.5 * (counts[k] - 1) as f64) * dx
-                    }));
-                }
+            // Each axis over its own count: a long thin rectangle costs its particle count,
+            // not the cube of its longest side.
+            for_each_index::<D>([0; D], counts.map(|n| n - 1), |idx| {
+                out.push(SVector::<f64, D>::from_fn(|k, _| {
+                    c[k] + (idx[k] as f64 - 0.5 * (counts[k] - 1) as f64) * dx
+                }));
             });
             out
         }
@@ -84,12 +84,12 @@ pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector
         .collect()
 }
 
-/// Calls `f` for every integer index in `[lo, hi]^D`, last axis fastest.
-fn for_each_index<const D: usize>(lo: i64, hi: i64, mut f: impl FnMut(&[i64; D])) {
-    if hi < lo {
+/// Calls `f` for every integer index `i` with `lo[k] <= i[k] <= hi[k]`, last axis fastest.
+fn for_each_index<const D: usize>(lo: [i64; D], hi: [i64; D], mut f: impl FnMut(&[i64; D])) {
+    if (0..D).any(|k| hi[k] < lo[k]) {
         return;
     }
-    let mut idx = [lo; D];
+    let mut idx = lo;
     loop {
         f(&idx);
         let mut k = D;
@@ -98,11 +98,11 @@ fn for_each_index<const D: usize>(lo: i64, hi: i64, mut f: impl FnMut(&[i64; D])
                 return;
             }
             k -= 1;
-            if idx[k] < hi {
+            if idx[k] < hi[k] {
                 idx[k] += 1;
                 break;
             }
-            idx[k] = lo;
+            idx[k] = lo[k];
         }
     }
 }
@@ -132,6 +132,13 @@ mod tests {
         assert!(c.norm() < 1e-12);
         let xmin = pts.iter().map(|p| p.x).fold(f64::INFINITY, f64::min);
         assert!((xmin + 0.49).abs() < 1e-12);
+    }
+
+    #[test]
+    fn long_thin_rectangle_costs_its_particle_count() {
+        // 1e6 × 1 lattice points: iterating the square of the long side would take hours.
+        let s = Shape::Rectangle { min: vec![0.0, 0.0], max: vec![1e4, 0.01] };
+        assert_eq!(lattice_points::<2>(&s, 0.01).len(), 1_000_000);
     }
 
     #[test]

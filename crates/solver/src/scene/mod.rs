@@ -18,6 +18,15 @@ impl Scene {
     /// Errors name the field path (`fluid.density`), the value and the rule; unknown
     /// fields and wrong types are errors too.
     pub fn from_json(text: &str) -> Result<Scene, SceneError> {
+        // serde would also read a struct from an array (`[name, dimension, ...]`), with
+        // errors naming `[0]`: a scene is an object.
+        let start = text.trim_start().chars().next();
+        if start.is_some_and(|c| c != '{') {
+            return Err(SceneError::parse(
+                "scene",
+                "a scene file must be a JSON object `{ \"name\": ..., ... }`",
+            ));
+        }
         let de = &mut serde_json::Deserializer::from_str(text);
         let scene: Scene = serde_path_to_error::deserialize(de).map_err(|e| {
             let path = e.path().to_string();

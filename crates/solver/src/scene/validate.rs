@@ -57,10 +57,46 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
                 "must be an axis of the scene (0..dimension)",
             ));
         }
+        if scene.boundaries.periodic[..i].iter().any(|a| a.axis == axis.axis) {
+            return Err(SceneError::new(
+                format!("{f}.axis"),
+                axis.axis,
+                "is periodic twice (list each axis once)",
+            ));
+        }
         finite(&format!("{f}.min"), axis.min)?;
         finite(&format!("{f}.max"), axis.max)?;
         if axis.max <= axis.min {
-            return Err(SceneError::new(format!("{f}.max"), axis.max, "must exceed min"));
+            return Err(SceneError::new(
+                format!("{f}.max"),
+                axis.max,
+                format!("must exceed min = {}", axis.min),
+            ));
+        }
+        let support = 2.0 * scene.h();
+        if axis.max - axis.min < 2.0 * support {
+            return Err(SceneError::new(
+                format!("{f}.max"),
+                axis.max,
+                format!(
+                    "the period max − min = {:e} m must be at least twice the kernel support 2h = {support:e} m \
+                     (the minimum-image convention sees one image of each neighbour)",
+                    axis.max - axis.min
+                ),
+            ));
+        }
+        for (j, body) in scene.bodies.iter().enumerate() {
+            let span = shape_span(&body.shape, axis.axis);
+            if span > (axis.max - axis.min) * (1.0 + 1e-9) {
+                return Err(SceneError::new(
+                    format!("bodies[{j}].shape"),
+                    format!("{span:e} m along axis {}", axis.axis),
+                    format!(
+                        "is longer than the period {:e} m of {f} (its particles would wrap onto each other)",
+                        axis.max - axis.min
+                    ),
+                ));
+            }
         }
     }
     match &scene.scheme {
@@ -71,7 +107,19 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         TimeStep::Fixed(dt) => {
             positive("time.step.fixed", dt)?;
             if dt > scene.time.end {
-                return Err(SceneError::new("time.step.fixed", dt, "must not exceed time.end"));
+                return Err(SceneError::new(
+                    "time.step.fixed",
+                    dt,
+                    format!("must not exceed time.end = {}", scene.time.end),
+                ));
+            }
+            let steps = scene.time.end / dt;
+            if steps > MAX_STEPS {
+                return Err(SceneError::new(
+                    "time.step.fixed",
+                    dt,
+                    format!("gives {steps:.3e} steps to time.end; at most {MAX_STEPS:.0e} are supported"),
+                ));
             }
         }
         TimeStep::Adaptive { cfl, viscous, max } => {
@@ -105,6 +153,42 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
 
 /// Largest particle count a scene may ask for (memory: about 1 kB per particle).
 const MAX_PARTICLES: f64 = 5e7;
+
+/// Largest number of fixed steps (the adaptive step's floor, 1e-9 of the end time, gives
+/// the same bound): beyond it `t + Δt` would lose Δt to rounding.
+const MAX_STEPS: f64 = 1e9;
+
+/// Shape coordinates must lie within this many Δx of the origin: further out, double
+/// precision (16 digits) cannot resolve the particle spacing to better than 1e-6 Δx.
+const MAX_COORDINATE_OVER_DX: f64 = 1e9;
+
+/// Extent of a shape along `axis` \[m\].
+fn shape_span(shape: &Shape, axis: usize) -> f64 {
+    match shape {
+        Shape::Circle { radius, .. } | Shape::Sphere { radius, .. } => 2.0 * radius,
+        Shape::Rectangle { min, max } | Shape::Box { min, max } => {
+            max.get(axis).copied().unwrap_or(0.0) - min.get(axis).copied().unwrap_or(0.0)
+        }
+    }
+}
+
+/// Checks that every coordinate of `v` lies within [`MAX_COORDINATE_OVER_DX`] Δx of the origin.
+fn near_origin(field: &str, v: &[f64], dx: f64) -> Result<(), SceneError> {
+    let limit = MAX_COORDINATE_OVER_DX * dx;
+    for (k, x) in v.iter().enumerate() {
+        if x.abs() > limit {
+            return Err(SceneError::new(
+                format!("{field}[{k}]"),
+                x,
+                format!(
+                    "must lie within 1e9 dx = {limit:e} m of the origin (further out, double precision \
+                     cannot resolve the particle spacing)"
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
 
 /// Area (2D) or volume (3D) of a validated shape \[m^D\].
 fn shape_measure(shape: &Shape) -> f64 {
@@ -177,7 +261,15 @@ fn validate_body(f: &str, body: &Body, d: usize, dx: f64) -> Result<(), SceneErr
                 ));
             }
             vector(&format!("{f}.shape.{kind}.center"), center, d)?;
+            near_origin(&format!("{f}.shape.{kind}.center"), center, dx)?;
             positive(&format!("{f}.shape.{kind}.radius"), *radius)?;
+            if *radius > MAX_COORDINATE_OVER_DX * dx {
+                return Err(SceneError::new(
+                    format!("{f}.shape.{kind}.radius"),
+                    radius,
+                    "must be at most 1e9 dx (double precision cannot resolve the particle spacing)",
+                ));
+            }
             if *radius < 0.5 * dx {
                 return Err(SceneError::new(
                     format!("{f}.shape.{kind}.radius"),
@@ -198,6 +290,8 @@ fn validate_body(f: &str, body: &Body, d: usize, dx: f64) -> Result<(), SceneErr
             }
             vector(&format!("{f}.shape.{kind}.min"), min, d)?;
             vector(&format!("{f}.shape.{kind}.max"), max, d)?;
+            near_origin(&format!("{f}.shape.{kind}.min"), min, dx)?;
+            near_origin(&format!("{f}.shape.{kind}.max"), max, dx)?;
             for k in 0..d {
                 if max[k] - min[k] < dx * (1.0 - 1e-9) {
                     return Err(SceneError::new(
