@@ -111,7 +111,9 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
 }
 
 /// Runs (or reuses) every spec of a case; returns the records in spec order and how many
-/// were executed. With `jobs > 1`, that many runs go concurrently.
+/// were executed. With `jobs > 1`, that many runs go concurrently, each in its own rayon
+/// pool with an equal share of the threads (small runs, like the channels' few thousand
+/// particles, gain nothing from a second thread: their steps are bound by synchronisation).
 fn run_specs(
     specs: &[RunSpec],
     case_dir: &Path,
@@ -136,13 +138,20 @@ fn run_specs(
         }
     }
     let next = AtomicUsize::new(0);
+    let jobs = opts.jobs.clamp(1, todo.len().max(1));
+    let threads = (rayon::current_num_threads() / jobs).max(1);
     let worker = || {
+        let pool = (jobs > 1).then(|| rayon::ThreadPoolBuilder::new().num_threads(threads).build());
         loop {
             let k = next.fetch_add(1, Ordering::Relaxed);
             let Some(&i) = todo.get(k) else { break };
             let spec = &specs[i];
             let mut run_bar = progress.run_bar(&spec.slug);
-            let result = sweep::execute(spec, &mut run_bar).and_then(|record| {
+            let result = match &pool {
+                Some(Ok(pool)) => pool.install(|| sweep::execute(spec, &mut run_bar)),
+                _ => sweep::execute(spec, &mut run_bar),
+            }
+            .and_then(|record| {
                 cache::store(&cache::record_path(case_dir, &spec.slug), &record)?;
                 Ok(record)
             });
@@ -154,7 +163,6 @@ fn run_specs(
             *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
         }
     };
-    let jobs = opts.jobs.clamp(1, todo.len().max(1));
     if jobs == 1 {
         worker();
     } else {
