@@ -141,6 +141,16 @@ pub enum ReferenceSpec {
         /// Density \[kg/m^3\].
         density: f64,
     },
+    /// The rotating square patch (`meniscus_reference::rotating_square`): the initial
+    /// pressure of the inviscid patch, against which the first PPE solve is compared.
+    RotatingSquare {
+        /// Side L \[m\].
+        side: f64,
+        /// Angular velocity ω \[1/s\] (`u = ω y, v = −ω x`).
+        omega: f64,
+        /// Density \[kg/m^3\].
+        density: f64,
+    },
     /// Plane Poiseuille start-up from rest (`meniscus_reference::poiseuille`); viscosity and
     /// body force come from each run's scene.
     PoiseuilleStartup {

@@ -8,6 +8,7 @@
 
 pub mod elliptical_drop;
 pub mod poiseuille;
+pub mod rotating_square;
 
 use crate::case::ReferenceSpec;
 use meniscus::ProbeRecord;
@@ -36,6 +37,10 @@ pub fn compute(
         }
         ReferenceSpec::PoiseuilleStartup { width, wall } => {
             poiseuille::compute(&poiseuille::channel(width, scene)?, wall, probes)?
+        }
+        ReferenceSpec::RotatingSquare { side, omega, density } => {
+            let patch = meniscus_reference::rotating_square::RotatingSquare::new(side, omega, density)?;
+            rotating_square::compute(&patch, &rotating_square::pressure_points(scene), probes)?
         }
     };
     m.metrics.insert("particles".into(), particles as f64);
