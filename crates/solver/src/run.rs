@@ -97,8 +97,8 @@ impl RunReport {
 #[derive(Debug)]
 pub struct Simulation<const D: usize> {
     scene: Scene,
-    state: State<D>,
-    stages: Vec<Box<dyn Stage<D>>>,
+    pub(crate) state: State<D>,
+    pub(crate) stages: Vec<Box<dyn Stage<D>>>,
     probes: ProbeSet<D>,
     bounds: (Vector<D>, Vector<D>),
 }
@@ -318,7 +318,7 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// Δt of the next step, never past `remaining` (Qiu eqs. 17–19 when adaptive).
-    fn time_step(&self, remaining: f64) -> Result<f64, Cause> {
+    pub(crate) fn time_step(&self, remaining: f64) -> Result<f64, Cause> {
         let dt = match self.scene.time.step {
             TimeStep::Fixed(dt) => dt,
             TimeStep::Adaptive { cfl, viscous, max } => {
@@ -344,7 +344,7 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// End-of-step checks: finite values, no particle escaped.
-    fn guard(&self) -> Result<(), Cause> {
+    pub(crate) fn guard(&self) -> Result<(), Cause> {
         let p = &self.state.particles;
         let (lo, hi) = &self.bounds;
         let bad = |a: usize| -> Option<Cause> {
