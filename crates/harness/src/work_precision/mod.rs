@@ -53,6 +53,17 @@ fn study_error(message: impl Into<String>) -> HarnessError {
     HarnessError::case("work_precision", message)
 }
 
+/// CPU time of this process, user + system, all threads \[s\] (`/proc/self/stat` fields 14
+/// and 15, in clock ticks of 1/100 s, the Linux value); `None` off Linux.
+fn process_cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+    // Fields after the command name (which may hold spaces) start at field 3.
+    let rest = &stat[stat.rfind(')')? + 1..];
+    let f: Vec<&str> = rest.split_whitespace().collect();
+    let ticks = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
+    Some(ticks / 100.0)
+}
+
 fn loadavg() -> Option<String> {
     std::fs::read_to_string("/proc/loadavg")
         .ok()
@@ -99,10 +110,11 @@ pub fn run(opts: &Options) -> Result<Study> {
         if opts.progress {
             let done = start.elapsed().as_secs_f64();
             eprintln!(
-                "[{:>3}/{total}] {:<52} {:>8.2} s  b err {:>9}  {}  ({:.0} s elapsed)",
+                "[{:>3}/{total}] {:<52} {:>8.2} s (CPU/wall {:>4})  b err {:>9}  {}  ({:.0} s elapsed)",
                 i + 1,
                 row.id,
                 row.wall_s,
+                row.cpu_s.map_or("—".into(), |c| format!("{:.2}", c / row.wall_s.max(1e-12))),
                 row.b_err.map_or("—".into(), |e| format!("{:.3} %", 100.0 * e)),
                 if row.ok() { "ok" } else { &row.status },
                 done
@@ -138,9 +150,11 @@ pub fn derive(study: &mut Study, tier: Tier) {
 fn execute(case: &Case, planned: &Planned, pool: &rayon::ThreadPool) -> Result<RunRow> {
     let scene = design::scene(case, &planned.variant, planned.dx)?;
     let id = planned.id();
+    let cpu0 = process_cpu_s();
     let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
         pool.install(|| meniscus::run(&scene, &mut meniscus::Quiet))
     }));
+    let cpu_s = process_cpu_s().zip(cpu0).map(|(b, a)| b - a);
     let mut row = RunRow {
         id: id.clone(),
         dx: planned.dx,
@@ -152,6 +166,7 @@ fn execute(case: &Case, planned: &Planned, pool: &rayon::ThreadPool) -> Result<R
         steps: 0,
         t_end: 0.0,
         wall_s: 0.0,
+        cpu_s,
         stages: Default::default(),
         ppe_iterations_mean: 0.0,
         b_err: None,
@@ -304,6 +319,7 @@ mod tests {
             assert_eq!(row.steps, 10);
             assert!(row.b_err.unwrap() < 0.05);
             assert!(row.stages.contains_key("ppe_solve"));
+            assert!(row.cpu_s.is_some_and(|c| c >= 0.0));
             study.runs.push(row);
         }
         derive(&mut study, Tier::Quick);

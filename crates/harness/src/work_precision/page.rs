@@ -44,6 +44,7 @@ fn run_row(r: &RunRow, front: bool) -> Markup {
             td { (r.particles) }
             td { (r.steps) }
             td { (format!("{:.3}", r.wall_s)) }
+            td { (r.cpu_s.map_or("—".into(), |c| format!("{:.2}", c / r.wall_s.max(1e-12)))) }
             td { (ms) }
             td { (format!("{:.1}", r.ppe_iterations_mean)) }
             td { (pct(r.b_err)) }
@@ -93,7 +94,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                 p class="small" {
                     "Timings were taken on a shared machine (load average "
                     (m.loadavg_start.as_deref().unwrap_or("?")) " at the start, "
-                    (m.loadavg_end.as_deref().unwrap_or("?")) " at the end): compare them as ratios within one study."
+                    (m.loadavg_end.as_deref().unwrap_or("?")) " at the end): compare them as ratios within one study. CPU/wall in the run table is the process CPU time over the wall time; well below the run's thread count, the run waited for the CPU."
                 }
                 h2 { "Figures" }
                 @for f in figures {
@@ -153,7 +154,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                     tr {
                         th class="l" { "run" } th { "Δx" } th class="l" { "PPE" } th class="l" { "gradient" } th class="l" { "divergence" }
                         th class="l" { "shifting" } th class="l" { "Δt" } th class="l" { "preset" } th { "threads" } th { "particles" }
-                        th { "steps" } th { "wall [s]" } th { "ms/step" } th { "PPE its" } th { "b error (t = 0.008)" } th { "b error (max)" } th class="l" { "status" }
+                        th { "steps" } th { "wall [s]" } th { "CPU/wall" } th { "ms/step" } th { "PPE its" } th { "b error (t = 0.008)" } th { "b error (max)" } th class="l" { "status" }
                     }
                     @for r in &study.runs { (run_row(r, study.pareto.contains(&r.id))) }
                 }

@@ -29,6 +29,10 @@ pub struct RunRow {
     pub t_end: f64,
     /// Wall time of the stepping loop \[s\].
     pub wall_s: f64,
+    /// CPU time of the process (all threads) over the run \[s\], from `/proc/self/stat`:
+    /// `cpu_s / wall_s` well below the thread count means the machine was busy.
+    #[serde(default)]
+    pub cpu_s: Option<f64>,
     /// Seconds per stage (the solver's `summary.json` `stages`, with `probes` and `guard`).
     pub stages: BTreeMap<String, f64>,
     /// Mean PPE iterations per step.

@@ -225,6 +225,7 @@ mod tests {
             steps: 400,
             t_end: 0.008,
             wall_s,
+            cpu_s: None,
             stages: Default::default(),
             ppe_iterations_mean: 10.0,
             b_err,
