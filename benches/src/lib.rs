@@ -1,8 +1,46 @@
-//! Shared fixtures for the criterion benches: the elliptical-drop scene at a given spacing.
+//! Shared fixtures for the criterion benches: the scenes benched, and a prepared state on
+//! which one stage can be re-run with representative work.
+//!
+//! Scenes: [`scenes`] lists every benched scene. Today that is the DESIGN.md elliptical
+//! drop at Δx = 0.04, 0.02, 0.01 ([`elliptical_drop`]); the periodic Poiseuille channel
+//! joins as one more function returning its `BenchScene`s, appended in [`scenes`], once
+//! the solver runs wall bodies.
+//!
+//! Stage benches ([`StageBench`]): the scene is stepped [`WARM_STEPS`] whole steps (so the
+//! PPE warm start, shifting and the particle order are those of a running simulation), the
+//! next step's stages are run up to the benched one, and the per-particle arrays are
+//! saved. Each timed iteration first restores them (untimed), then runs the stage alone
+//! (timed), on a worker thread of the rayon pool as the run driver does. The PPE solve
+//! therefore always starts from the pressure at the start of the step (not from its own
+//! previous solution), `correction` and `shifting` always apply the same update, and the
+//! stages that overwrite their outputs (`free_surface`, `viscosity`, `ppe_assemble`,
+//! `neighbours`) do exactly one step's work per iteration. The neighbour stage is not
+//! restored (it rebuilds the lists from unchanged positions); it reorders the particles by
+//! cell every 25th call, so its mean includes that amortised cost, as in a run.
 
 use meniscus::Scene;
+use meniscus::profile::{Snapshot, Stepper, on_worker};
+use meniscus::scene::{PpeSolver, Scheme, Shifting};
+use meniscus::stage::StepContext;
+use std::time::{Duration, Instant};
 
-/// The DESIGN.md elliptical-drop scene at spacing `dx`, ending after `steps` steps.
+/// Whole steps taken before a stage is benched.
+pub const WARM_STEPS: usize = 5;
+
+/// Spacings of the drop benches \[m\].
+pub const DROP_SPACINGS: [f64; 3] = [0.04, 0.02, 0.01];
+
+/// A scene to bench and its label.
+#[derive(Debug, Clone)]
+pub struct BenchScene {
+    /// Label used in benchmark ids, e.g. `drop_dx0.02`.
+    pub label: String,
+    /// The scene.
+    pub scene: Scene,
+}
+
+/// The DESIGN.md elliptical-drop scene at spacing `dx`, ending after `steps` steps of its
+/// fixed Δt.
 pub fn drop_scene(dx: f64, steps: usize) -> Scene {
     let text = include_str!("../../validation/scenes/elliptical_drop.json");
     let mut scene = Scene::from_json(text).expect("the committed scene is valid");
@@ -11,4 +49,190 @@ pub fn drop_scene(dx: f64, steps: usize) -> Scene {
         scene.time.end = dt * steps as f64;
     }
     scene
+}
+
+/// The elliptical drop (paper preset: BiCGSTAB 1e-3, eq. 10 divergence, Xu shifting) at
+/// every spacing of [`DROP_SPACINGS`].
+pub fn elliptical_drop() -> Vec<BenchScene> {
+    DROP_SPACINGS
+        .iter()
+        .map(|&dx| BenchScene { label: format!("drop_dx{dx}"), scene: drop_scene(dx, 400) })
+        .collect()
+}
+
+/// Every benched scene (add the periodic Poiseuille channel here when it exists).
+pub fn scenes() -> Vec<BenchScene> {
+    elliptical_drop()
+}
+
+/// `scene` with its PPE solved by `solver` (Krylov tolerance 1e-3, the paper's).
+pub fn with_ppe_solver(scene: &Scene, solver: PpeSolver) -> Scene {
+    let mut s = scene.clone();
+    let Scheme::Isph(opts) = &mut s.scheme;
+    opts.ppe.solver = solver;
+    opts.ppe.tolerance = 1e-3;
+    s
+}
+
+/// `scene` with the given shifting law.
+pub fn with_shifting(scene: &Scene, shifting: Shifting) -> Scene {
+    let mut s = scene.clone();
+    let Scheme::Isph(opts) = &mut s.scheme;
+    opts.shifting = shifting;
+    s
+}
+
+/// `scene` with the kernel-corrected velocity divergence on the PPE source.
+pub fn with_corrected_divergence(scene: &Scene) -> Scene {
+    let mut s = scene.clone();
+    let Scheme::Isph(opts) = &mut s.scheme;
+    opts.divergence = meniscus::scene::Divergence::Corrected;
+    s
+}
+
+/// Particle and pair counts of a scene's state after [`WARM_STEPS`] steps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Size {
+    /// Particles.
+    pub particles: usize,
+    /// Neighbour pairs (both orders, self included).
+    pub pairs: usize,
+}
+
+/// One stage of a 2D scene, ready to be re-run with the work of a real step (see the
+/// crate documentation).
+#[derive(Debug)]
+pub struct StageBench {
+    stepper: Stepper<2>,
+    ctx: StepContext,
+    stage: usize,
+    snapshot: Option<Snapshot<2>>,
+}
+
+impl StageBench {
+    /// Prepares stage `name` of `scene`; `None` when the scene does not build that stage.
+    /// With `restore = false` the stage is re-run without restoring the particle arrays
+    /// (for the neighbour stage, which must not be restored across its reordering).
+    pub fn new(scene: &Scene, name: &str, restore: bool) -> Option<Self> {
+        let mut stepper = Stepper::<2>::new(scene).expect("bench scenes are valid");
+        let stage = stepper.stage_index(name)?;
+        on_worker(|| -> Option<Self> {
+            for _ in 0..WARM_STEPS {
+                stepper.step_once().expect("the warm-up steps are stable");
+            }
+            let ctx = stepper.begin_step().expect("a time step");
+            stepper.run_stages_before(stage, &ctx).expect("the stages before the benched one run");
+            let snapshot = restore.then(|| stepper.snapshot());
+            Some(Self { stepper, ctx, stage, snapshot })
+        })
+    }
+
+    /// Particle and pair counts of the prepared state.
+    pub fn size(&self) -> Size {
+        let st = self.stepper.state();
+        Size { particles: st.particles.len(), pairs: st.neighbours.pairs() }
+    }
+
+    /// PPE iterations of the last run of the stage (meaningful for `ppe_solve`).
+    pub fn ppe_iterations(&self) -> usize {
+        self.stepper.state().ppe.info.iterations
+    }
+
+    /// Runs the stage `iters` times and returns the time spent in the stage alone (the
+    /// restores between runs are not timed). For criterion's `iter_custom`.
+    pub fn time(&mut self, iters: u64) -> Duration {
+        on_worker(|| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                if let Some(snap) = &self.snapshot {
+                    self.stepper.restore(snap);
+                }
+                let t0 = Instant::now();
+                let r = self.stepper.run_stage(self.stage, &self.ctx);
+                total += t0.elapsed();
+                r.expect("the benched stage runs");
+            }
+            total
+        })
+    }
+}
+
+/// Whole steps of a 2D scene, each from the same state (restored untimed before each).
+#[derive(Debug)]
+pub struct StepBench {
+    stepper: Stepper<2>,
+    snapshot: Snapshot<2>,
+}
+
+impl StepBench {
+    /// Steps `scene` [`WARM_STEPS`] times and saves the state.
+    pub fn new(scene: &Scene) -> Self {
+        let mut stepper = Stepper::<2>::new(scene).expect("bench scenes are valid");
+        on_worker(|| {
+            for _ in 0..WARM_STEPS {
+                stepper.step_once().expect("the warm-up steps are stable");
+            }
+        });
+        let snapshot = stepper.snapshot();
+        Self { stepper, snapshot }
+    }
+
+    /// Particles of the scene.
+    pub fn particles(&self) -> usize {
+        self.stepper.state().particles.len()
+    }
+
+    /// Takes `iters` whole steps (time step, every stage, guard), each from the saved
+    /// state, and returns the time spent stepping.
+    pub fn time(&mut self, iters: u64) -> Duration {
+        on_worker(|| {
+            let mut total = Duration::ZERO;
+            for _ in 0..iters {
+                self.stepper.restore(&self.snapshot);
+                let t0 = Instant::now();
+                let r = self.stepper.step_once();
+                total += t0.elapsed();
+                r.expect("the benched step is stable");
+            }
+            total
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn stage_bench_repeats_the_same_solve() {
+        let scene = drop_scene(0.05, 10);
+        let mut b = StageBench::new(&scene, "ppe_solve", true).unwrap();
+        b.time(1);
+        let first = b.ppe_iterations();
+        assert!(first > 0);
+        b.time(3);
+        assert_eq!(b.ppe_iterations(), first, "each solve starts from the start-of-step pressure");
+        assert!(b.size().pairs > 10 * b.size().particles);
+        assert!(StageBench::new(&with_shifting(&scene, Shifting::None), "shifting", true).is_none());
+    }
+
+    #[test]
+    fn step_bench_restarts_from_the_saved_state() {
+        let mut b = StepBench::new(&drop_scene(0.05, 10));
+        assert!(b.time(2) > Duration::ZERO);
+        assert_eq!(b.stepper.steps(), WARM_STEPS + 1);
+    }
+
+    #[test]
+    fn every_scene_is_labelled_and_valid() {
+        let s = scenes();
+        assert_eq!(s.len(), 3);
+        assert_eq!(s[1].label, "drop_dx0.02");
+        for b in &s {
+            meniscus::scene::validate(&b.scene).unwrap();
+        }
+        let direct = with_ppe_solver(&s[0].scene, PpeSolver::Direct);
+        let Scheme::Isph(o) = &direct.scheme;
+        assert_eq!(o.ppe.solver, PpeSolver::Direct);
+    }
 }

@@ -1,7 +1,8 @@
-//! Project tasks: `cargo xtask validate | report` (DESIGN.md "Command lines").
+//! Project tasks: `cargo xtask validate | bench | report` (DESIGN.md "Command lines").
 //!
 //! Thin by design: parsing and dispatch only; the logic lives in `meniscus-harness`.
 
+mod bench;
 mod report;
 mod validate;
 
@@ -23,6 +24,9 @@ enum Command {
     /// Run the validation cases, write reports/<case>/results.json, summary.json and the
     /// HTML report; exit code 0 only when every check passes.
     Validate(validate::Args),
+    /// Run the work-precision study of the elliptical drop into reports/work_precision/
+    /// (results.json, SVGs, index.html) and print the performance targets' verdicts.
+    Bench(bench::Args),
     /// Re-render the HTML report and summary.json from the existing results files (no runs).
     Report(report::Args),
 }
@@ -31,6 +35,7 @@ fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Validate(args) => validate::run(args),
+        Command::Bench(args) => bench::run(args),
         Command::Report(args) => report::run(args),
     };
     match result {

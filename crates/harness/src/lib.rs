@@ -30,6 +30,7 @@ pub mod report;
 pub mod results;
 pub mod sweep;
 pub mod validate;
+pub mod work_precision;
 
 pub use case::{Case, Tier};
 pub use error::{HarnessError, Result};

@@ -15,6 +15,7 @@ pub mod kernel;
 pub mod neighbours;
 pub mod ppe;
 pub mod probes;
+pub mod profile;
 pub mod run;
 pub mod scene;
 pub mod stage;

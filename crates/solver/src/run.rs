@@ -101,8 +101,8 @@ impl RunReport {
 #[derive(Debug)]
 pub struct Simulation<const D: usize> {
     scene: Scene,
-    state: State<D>,
-    stages: Vec<Box<dyn Stage<D>>>,
+    pub(crate) state: State<D>,
+    pub(crate) stages: Vec<Box<dyn Stage<D>>>,
     probes: ProbeSet<D>,
     bounds: (Vector<D>, Vector<D>),
     neighbour_band: NeighbourBand,
@@ -413,7 +413,7 @@ impl<const D: usize> Simulation<D> {
 
     /// Δt of the next step, never past `remaining` (the time to the end or to the next
     /// requested probe time; Qiu eqs. 17–19 when adaptive).
-    fn time_step(&self, remaining: f64) -> Result<f64, Cause> {
+    pub(crate) fn time_step(&self, remaining: f64) -> Result<f64, Cause> {
         let dt = match self.scene.time.step {
             TimeStep::Fixed(dt) => dt,
             TimeStep::Adaptive { cfl, viscous, max } => {
@@ -444,7 +444,7 @@ impl<const D: usize> Simulation<D> {
     /// enlarged by four times its size); no fluid particle has more neighbours than the
     /// [`NeighbourBand`] allows. The cause names the lowest particle id that failed the
     /// most severe check and how many others failed it too.
-    fn guard(&self) -> Result<(), Cause> {
+    pub(crate) fn guard(&self) -> Result<(), Cause> {
         use rayon::prelude::*;
         let p = &self.state.particles;
         let (lo, hi) = &self.bounds;

@@ -1,0 +1,165 @@
+//! The study's self-contained HTML page (maud; inline CSS, figures inlined as SVG).
+
+use super::record::{RunRow, Study};
+use maud::{DOCTYPE, Markup, PreEscaped, html};
+
+const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1250px;color:#222}\
+table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}\
+th{background:#f0f0f0}td.l,th.l{text-align:left}.pass{background:#d9f2d9;color:#145214}\
+.fail{background:#f8d7d7;color:#7a1010}.na{background:#eee;color:#555}tr.front td{font-weight:bold}\
+figure{display:inline-block;margin:0.5em;vertical-align:top}figcaption{font-size:90%;color:#555;max-width:820px}\
+code{font-size:90%}.small{font-size:85%}";
+
+/// A figure: file name (without `.svg`), SVG text and caption.
+pub struct Figure {
+    /// File name without extension.
+    pub file: String,
+    /// The SVG document.
+    pub svg: String,
+    /// What it shows.
+    pub caption: String,
+}
+
+fn pct(v: Option<f64>) -> String {
+    v.map_or("—".into(), |x| if x.is_finite() { format!("{:.3} %", 100.0 * x) } else { "NaN".into() })
+}
+
+fn value(v: Option<f64>, unit: &str) -> String {
+    v.map_or("—".into(), |x| if unit.is_empty() { format!("{x:.3}") } else { format!("{x:.3} {unit}") })
+}
+
+fn run_row(r: &RunRow, front: bool) -> Markup {
+    let ms = r.cost_per_step().map_or("—".into(), |s| format!("{:.2}", 1e3 * s));
+    html! {
+        tr class=(if front { "front" } else { "" }) {
+            td class="l" { code { (r.id) } }
+            td { (r.dx) }
+            td class="l" { (serde_json::to_value(r.variant.ppe).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()) }
+            td class="l" { (format!("{:?}", r.variant.gradient).to_lowercase()) }
+            td class="l" { (format!("{:?}", r.variant.divergence).to_lowercase()) }
+            td class="l" { (format!("{:?}", r.variant.shifting).to_lowercase()) }
+            td class="l" { (format!("{:?}", r.variant.dt).to_lowercase()) }
+            td class="l" { (r.preset.as_deref().unwrap_or("")) }
+            td { (r.threads) }
+            td { (r.particles) }
+            td { (r.steps) }
+            td { (format!("{:.3}", r.wall_s)) }
+            td { (r.cpu_s.map_or("—".into(), |c| format!("{:.2}", c / r.wall_s.max(1e-12)))) }
+            td { (ms) }
+            td { (format!("{:.1}", r.ppe_iterations_mean)) }
+            td { (pct(r.b_err)) }
+            td { (pct(r.b_err_max)) }
+            td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
+        }
+    }
+}
+
+/// The page of a study, with its figures inlined.
+pub fn render(study: &Study, figures: &[Figure]) -> String {
+    let m = &study.machine;
+    let p = &m.provenance;
+    let front: Vec<&RunRow> =
+        study.pareto.iter().filter_map(|id| study.runs.iter().find(|r| &r.id == id)).collect();
+    let diverged = study.runs.iter().filter(|r| !r.ok()).count();
+    html! {
+        (DOCTYPE)
+        html lang="en" {
+            head {
+                meta charset="utf-8";
+                title { "Meniscus work-precision study (elliptical drop)" }
+                style { (PreEscaped(CSS)) }
+            }
+            body {
+                h1 { "Work-precision study: elliptical drop" }
+                p {
+                    "Wall time against the relative error of the semi-axis b at t = 0.008 s (second moments, against the ellipse ODE), for "
+                    (study.runs.len()) " runs of the " code { (study.case) } " scene ("
+                    (diverged) " diverged), tier " b { (study.tier) } ", " (study.threads) " threads for the main runs; the study took "
+                    (format!("{:.0}", study.elapsed_s)) " s."
+                    @if !study.complete { " " b { "Incomplete: the study was interrupted." } }
+                }
+                h2 { "Targets" }
+                table {
+                    tr { th class="l" { "target" } th { "measured" } th { "threshold" } th { "verdict" } th class="l" { "how" } }
+                    @for t in &study.targets {
+                        tr {
+                            td class="l" { (t.name) }
+                            td { (value(t.value, &t.unit)) }
+                            td { (if t.kind == "max" { "≤ " } else { "≥ " }) (value(Some(t.threshold), &t.unit)) }
+                            td class=(match t.pass { Some(true) => "pass", Some(false) => "fail", None => "na" }) { (t.verdict()) }
+                            td class="l small" { (t.note) }
+                        }
+                    }
+                }
+                p class="small" {
+                    "Timings were taken on a shared machine (load average "
+                    (m.loadavg_start.as_deref().unwrap_or("?")) " at the start, "
+                    (m.loadavg_end.as_deref().unwrap_or("?")) " at the end): compare them as ratios within one study. CPU/wall in the run table is the process CPU time over the wall time; well below the run's thread count, the run waited for the CPU."
+                }
+                h2 { "Figures" }
+                @for f in figures {
+                    figure {
+                        (PreEscaped(&f.svg))
+                        figcaption { (f.caption) " (" a href=(format!("{}.svg", f.file)) { (f.file) ".svg" } ")" }
+                    }
+                }
+                h2 { "Pareto front" }
+                p { "Runs that no other run (" (study.threads) " threads) beats on both wall time and b error, cheapest first." }
+                table {
+                    tr { th class="l" { "run" } th { "wall [s]" } th { "b error" } }
+                    @for r in &front { tr { td class="l" { code { (r.id) } } td { (format!("{:.3}", r.wall_s)) } td { (pct(r.b_err)) } } }
+                }
+                h2 { "Cost per step and threads" }
+                table {
+                    tr { th class="l" { "preset" } th { "threads" } th { "fitted exponent" } th class="l" { "Δx" } th class="l" { "particles" } th class="l" { "ms per step" } }
+                    @for f in &study.cost_fits {
+                        tr {
+                            td class="l" { (f.preset) } td { (f.threads) } td { (value(f.exponent, "")) }
+                            td class="l" { (f.dx.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")) }
+                            td class="l" { (f.particles.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")) }
+                            td class="l" { (f.cost_per_step_s.iter().map(|s| format!("{:.2}", 1e3 * s)).collect::<Vec<_>>().join(", ")) }
+                        }
+                    }
+                }
+                table {
+                    tr { th class="l" { "preset" } th { "Δx" } th { "particles" } th { "1 thread [s]" } th { "parallel [s]" } th { "threads" } th { "speed-up" } }
+                    @for s in &study.speedups {
+                        tr {
+                            td class="l" { (s.preset) } td { (s.dx) } td { (s.particles) } td { (format!("{:.3}", s.wall_1_s)) }
+                            td { (format!("{:.3}", s.wall_n_s)) } td { (s.threads) } td { (format!("{:.2}", s.speedup)) }
+                        }
+                    }
+                }
+                h2 { "Design" }
+                ul { @for d in &study.design { li { (d) } } }
+                p class="small" {
+                    "Factors: PPE solver and tolerance (BiCGSTAB 1e-3, BiCGSTAB 1e-5, CG 1e-3, sparse LU), pressure gradient "
+                    "(symmetric Qiu eq. 15, difference), divergence (Qiu eq. 10, kernel-corrected), shifting (none, Xu C = 0.02, "
+                    "Fickian A = 2), time step (the case's fixed Δt = 2e-5 s scaled with Δx below 0.02, adaptive Qiu eqs. 17–19 "
+                    "with α = 0.2). Presets: paper = BiCGSTAB 1e-3, symmetric, eq. 10, Xu, fixed; tuned = paper with the "
+                    "corrected divergence and Fickian shifting. Runs go one at a time, each on its own rayon pool."
+                }
+                h2 { "Machine" }
+                table {
+                    tr { th class="l" { "git commit" } td class="l" { code { (p.git_commit.as_deref().unwrap_or("unknown")) } (if p.git_dirty == Some(true) { " (uncommitted changes)" } else { "" }) } }
+                    tr { th class="l" { "CPU" } td class="l" { (p.cpu.as_deref().unwrap_or("unknown")) } }
+                    tr { th class="l" { "logical CPUs" } td class="l" { (p.cpus.map_or("unknown".into(), |c| c.to_string())) } }
+                    tr { th class="l" { "threads (main runs)" } td class="l" { (study.threads) } }
+                    tr { th class="l" { "host" } td class="l" { (p.hostname.as_deref().unwrap_or("unknown")) } }
+                    tr { th class="l" { "date (UTC)" } td class="l" { (p.date_utc) } }
+                }
+                h2 { "All runs" }
+                p class="small" { "Bold rows are on the Pareto front. Data: " a href="results.json" { "results.json" } "." }
+                table class="small" {
+                    tr {
+                        th class="l" { "run" } th { "Δx" } th class="l" { "PPE" } th class="l" { "gradient" } th class="l" { "divergence" }
+                        th class="l" { "shifting" } th class="l" { "Δt" } th class="l" { "preset" } th { "threads" } th { "particles" }
+                        th { "steps" } th { "wall [s]" } th { "CPU/wall" } th { "ms/step" } th { "PPE its" } th { "b error (t = 0.008)" } th { "b error (max)" } th class="l" { "status" }
+                    }
+                    @for r in &study.runs { (run_row(r, study.pareto.contains(&r.id))) }
+                }
+            }
+        }
+    }
+    .into_string()
+}

@@ -1,0 +1,362 @@
+//! The study's SVG figures (plotters, SVG backend), drawn from the run rows alone.
+//!
+//! The report's chart functions (`crate::report::plots`) take validation `RunResult`s and
+//! draw one kind of chart each; these four need other data (Pareto front, stacked stage
+//! times, fits against particle count, speed-ups), so they live here with the same look
+//! (size, fonts, palette, legend on a translucent box).
+
+use super::record::{CostFit, RunRow, SpeedUp};
+use super::targets::thresholds;
+use crate::error::{HarnessError, Result};
+use plotters::coord::Shift;
+use plotters::prelude::*;
+
+/// Figure size in pixels.
+const SIZE: (u32, u32) = (820, 480);
+
+/// Category colours.
+const PALETTE: [RGBColor; 10] = [
+    RGBColor(31, 119, 180),
+    RGBColor(255, 127, 14),
+    RGBColor(44, 160, 44),
+    RGBColor(214, 39, 40),
+    RGBColor(148, 103, 189),
+    RGBColor(140, 86, 75),
+    RGBColor(227, 119, 194),
+    RGBColor(127, 127, 127),
+    RGBColor(188, 189, 34),
+    RGBColor(23, 190, 207),
+];
+
+fn colour(i: usize) -> RGBColor {
+    PALETTE[i % PALETTE.len()]
+}
+
+type DrawResult = std::result::Result<(), Box<dyn std::fmt::Debug>>;
+
+fn boxed<E: std::fmt::Debug + 'static>(e: E) -> Box<dyn std::fmt::Debug> {
+    Box::new(e)
+}
+
+/// Draws into an SVG string of [`SIZE`] on white; errors name the figure.
+fn svg(file: &str, draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> DrawResult) -> Result<String> {
+    let mut out = String::new();
+    {
+        let root = SVGBackend::with_string(&mut out, SIZE).into_drawing_area();
+        let r = root
+            .fill(&WHITE)
+            .map_err(boxed)
+            .and_then(|_| draw(&root))
+            .and_then(|_| root.present().map_err(boxed));
+        r.map_err(|e| HarnessError::Plot { file: file.to_string(), message: format!("{e:?}") })?;
+    }
+    Ok(out)
+}
+
+/// `(lo, hi)` of the positive finite values widened by `factor` each side, for a log axis.
+fn log_range(values: impl Iterator<Item = f64>, factor: f64) -> (f64, f64) {
+    let (lo, hi) = values
+        .filter(|v| v.is_finite() && *v > 0.0)
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| (l.min(v), h.max(v)));
+    if lo.is_finite() { (lo / factor, hi * factor) } else { (0.1, 10.0) }
+}
+
+fn legend<'a, CT: plotters::coord::CoordTranslate>(
+    chart: &mut ChartContext<'a, SVGBackend<'a>, CT>,
+    position: SeriesLabelPosition,
+) -> DrawResult {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .label_font(("sans-serif", 12))
+        .draw()
+        .map_err(boxed)
+}
+
+/// A relative error as a percentage with two significant digits.
+fn percent(v: f64) -> String {
+    let p = 100.0 * v;
+    let digits = if p > 0.0 { (1.0 - p.log10().floor()).max(0.0) as usize } else { 0 };
+    format!("{p:.digits$} %")
+}
+
+/// Distinct spacings of the rows, coarse to fine.
+fn spacings(rows: &[&RunRow]) -> Vec<f64> {
+    let mut dx: Vec<f64> = rows.iter().map(|r| r.dx).collect();
+    dx.sort_by(|a, b| b.total_cmp(a));
+    dx.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    dx
+}
+
+/// Wall time against b error (log-log), one colour per spacing; the Pareto front (ids in
+/// `front`, cheapest first) joined by a black line; the presets labelled; the target box
+/// (b error ≤ 0.5 % within 1 s) dashed.
+pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<String> {
+    let pts: Vec<(&RunRow, f64)> = runs
+        .iter()
+        .filter(|r| r.ok())
+        .filter_map(|r| r.b_err.filter(|e| *e > 0.0).map(|e| (*r, e)))
+        .collect();
+    let (x0, x1) = log_range(pts.iter().map(|p| p.1).chain([thresholds::B_ERR]), 1.6);
+    let (y0, y1) = log_range(pts.iter().map(|p| p.0.wall_s).chain([thresholds::B_ERR_WALL_S]), 1.6);
+    let rows: Vec<&RunRow> = pts.iter().map(|p| p.0).collect();
+    let dxs = spacings(&rows);
+    svg(file, |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption("Work-precision: wall time against b error at t = 0.008 s", ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(42)
+            .y_label_area_size(64)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .map_err(boxed)?;
+        chart
+            .configure_mesh()
+            .x_desc("relative b error at t = 0.008 s")
+            .y_desc("wall time [s]")
+            .x_label_formatter(&|v| percent(*v))
+            .y_label_formatter(&|v| format!("{v:.2}"))
+            .draw()
+            .map_err(boxed)?;
+        let grey = RGBColor(120, 120, 120);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [
+                    (x0, thresholds::B_ERR_WALL_S),
+                    (thresholds::B_ERR, thresholds::B_ERR_WALL_S),
+                    (thresholds::B_ERR, y0),
+                ],
+                6,
+                4,
+                grey.stroke_width(1),
+            ))
+            .map_err(boxed)?
+            .label("target: b error ≤ 0.5 % within 1 s")
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        for (i, dx) in dxs.iter().enumerate() {
+            let c = colour(i);
+            let mine: Vec<(f64, f64)> =
+                pts.iter().filter(|p| (p.0.dx - dx).abs() < 1e-12).map(|p| (p.1, p.0.wall_s)).collect();
+            chart
+                .draw_series(mine.iter().map(|&p| Circle::new(p, 3, c.mix(0.75).filled())))
+                .map_err(boxed)?
+                .label(format!("Δx = {dx} ({} runs)", mine.len()))
+                .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
+        }
+        let front_pts: Vec<(f64, f64)> = front
+            .iter()
+            .filter_map(|id| pts.iter().find(|p| &p.0.id == id))
+            .map(|p| (p.1, p.0.wall_s))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(front_pts.clone(), BLACK.stroke_width(2)))
+            .map_err(boxed)?
+            .label(format!("Pareto front ({} runs)", front_pts.len()))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+        chart
+            .draw_series(front_pts.iter().map(|&p| Circle::new(p, 6, BLACK.stroke_width(2))))
+            .map_err(boxed)?;
+        chart
+            .draw_series(pts.iter().filter_map(|p| {
+                p.0.preset.as_ref().map(|name| {
+                    Text::new(format!("{name} Δx={}", p.0.dx), (p.1, p.0.wall_s), ("sans-serif", 11))
+                })
+            }))
+            .map_err(boxed)?;
+        legend(&mut chart, SeriesLabelPosition::UpperRight)
+    })
+}
+
+/// Horizontal stacked bars: microseconds per particle and step spent in each stage, for
+/// each row in `bars` (label, run).
+pub fn stage_breakdown(file: &str, bars: &[(String, &RunRow)]) -> Result<String> {
+    let mut stages: Vec<String> = bars.iter().flat_map(|(_, r)| r.stages.keys().cloned()).collect();
+    stages.sort();
+    stages.dedup();
+    // Largest total first in the legend.
+    let total = |s: &str| bars.iter().map(|(_, r)| r.stages.get(s).copied().unwrap_or(0.0)).sum::<f64>();
+    stages.sort_by(|a, b| total(b).total_cmp(&total(a)));
+    let per = |r: &RunRow, s: &str| {
+        let work = (r.particles * r.steps.max(1)) as f64;
+        1e6 * r.stages.get(s).copied().unwrap_or(0.0) / work
+    };
+    let width = bars.iter().map(|(_, r)| stages.iter().map(|s| per(r, s)).sum::<f64>()).fold(0.0, f64::max);
+    let n = bars.len().max(1);
+    let labels: Vec<String> = bars.iter().map(|(l, _)| l.clone()).collect();
+    svg(file, |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption("Time per particle and step, by stage", ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(42)
+            .y_label_area_size(220)
+            .build_cartesian_2d(0.0..width * 1.35 + 1e-9, -0.5..(n as f64 - 0.5))
+            .map_err(boxed)?;
+        let label_of = |v: &f64| {
+            let i = v.round();
+            if (v - i).abs() < 1e-6 && i >= 0.0 {
+                labels.get(i as usize).cloned().unwrap_or_default()
+            } else {
+                String::new()
+            }
+        };
+        chart
+            .configure_mesh()
+            .disable_y_mesh()
+            .y_labels(n)
+            .y_label_formatter(&label_of)
+            .x_desc("µs per particle-step")
+            .draw()
+            .map_err(boxed)?;
+        for (k, s) in stages.iter().enumerate() {
+            let c = colour(k);
+            let rects: Vec<Rectangle<(f64, f64)>> = bars
+                .iter()
+                .enumerate()
+                .map(|(i, (_, r))| {
+                    let start: f64 = stages[..k].iter().map(|t| per(r, t)).sum();
+                    let y = i as f64;
+                    Rectangle::new([(start, y - 0.35), (start + per(r, s), y + 0.35)], c.filled())
+                })
+                .collect();
+            chart
+                .draw_series(rects)
+                .map_err(boxed)?
+                .label(s.clone())
+                .legend(move |(x, y)| Rectangle::new([(x, y - 5), (x + 12, y + 5)], c.filled()));
+        }
+        legend(&mut chart, SeriesLabelPosition::LowerRight)
+    })
+}
+
+/// Seconds per step against particle count (log-log), one colour per preset: the
+/// main-thread runs with their fitted power law (exponent in the legend), one-thread runs
+/// as hollow markers.
+pub fn cost_scaling(file: &str, fits: &[CostFit], one_thread: &[&RunRow]) -> Result<String> {
+    let all_n = fits.iter().flat_map(|f| f.particles.iter().map(|&p| p as f64));
+    let (x0, x1) = log_range(all_n.chain(one_thread.iter().map(|r| r.particles as f64)), 1.5);
+    let (y0, y1) = log_range(
+        fits.iter()
+            .flat_map(|f| f.cost_per_step_s.iter().copied())
+            .chain(one_thread.iter().filter_map(|r| r.cost_per_step())),
+        2.0,
+    );
+    svg(file, |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption("Cost per step against particle count", ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(42)
+            .y_label_area_size(64)
+            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
+            .map_err(boxed)?;
+        chart
+            .configure_mesh()
+            .x_desc("particles")
+            .y_desc("seconds per step")
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .y_label_formatter(&|v| format!("{v:.0e}"))
+            .draw()
+            .map_err(boxed)?;
+        for (i, f) in fits.iter().enumerate() {
+            let c = colour(i);
+            let pts: Vec<(f64, f64)> =
+                f.particles.iter().zip(&f.cost_per_step_s).map(|(&n, &s)| (n as f64, s)).collect();
+            let label = match f.exponent {
+                Some(p) => format!("{} ({} threads): fitted exponent {p:.3}", f.preset, f.threads),
+                None => format!("{} ({} threads): no fit", f.preset, f.threads),
+            };
+            chart
+                .draw_series(pts.iter().map(|&p| Circle::new(p, 5, c.filled())))
+                .map_err(boxed)?
+                .label(label)
+                .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+            if let (Some(p), Some(k)) = (f.exponent, f.constant) {
+                let line: Vec<(f64, f64)> =
+                    [x0 * 1.2, x1 / 1.2].iter().map(|&n| (n, k * n.powf(p))).collect();
+                chart.draw_series(LineSeries::new(line, c.stroke_width(1))).map_err(boxed)?;
+            }
+            let ones: Vec<(f64, f64)> = one_thread
+                .iter()
+                .filter(|r| r.preset.as_deref() == Some(f.preset.as_str()))
+                .filter_map(|r| r.cost_per_step().map(|s| (r.particles as f64, s)))
+                .collect();
+            if !ones.is_empty() {
+                chart
+                    .draw_series(ones.iter().map(|&p| Circle::new(p, 5, c.stroke_width(2))))
+                    .map_err(boxed)?
+                    .label(format!("{} (1 thread)", f.preset))
+                    .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.stroke_width(2)));
+            }
+        }
+        legend(&mut chart, SeriesLabelPosition::UpperLeft)
+    })
+}
+
+/// Speed-up of the main thread count over one thread against particle count, one line per
+/// preset, with the target (1.7) and the ideal (the thread count).
+pub fn speedup(file: &str, ups: &[SpeedUp], threads: usize) -> Result<String> {
+    let (x0, x1) = log_range(ups.iter().map(|s| s.particles as f64), 1.5);
+    let top = ups.iter().map(|s| s.speedup).fold(threads as f64, f64::max) * 1.15;
+    svg(file, |root| {
+        let mut chart = ChartBuilder::on(root)
+            .caption(format!("Speed-up, 1 → {threads} threads"), ("sans-serif", 18))
+            .margin(12)
+            .x_label_area_size(42)
+            .y_label_area_size(64)
+            .build_cartesian_2d((x0..x1).log_scale(), 0.0..top)
+            .map_err(boxed)?;
+        chart
+            .configure_mesh()
+            .x_desc("particles")
+            .y_desc("wall time (1 thread) / wall time")
+            .x_label_formatter(&|v| format!("{v:.0}"))
+            .draw()
+            .map_err(boxed)?;
+        let grey = RGBColor(120, 120, 120);
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x0, thresholds::SPEEDUP), (x1, thresholds::SPEEDUP)],
+                6,
+                4,
+                RED.stroke_width(1),
+            ))
+            .map_err(boxed)?
+            .label(format!("target {} at Δx = 0.01", thresholds::SPEEDUP))
+            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], RED));
+        chart
+            .draw_series(DashedLineSeries::new(
+                [(x0, threads as f64), (x1, threads as f64)],
+                2,
+                4,
+                grey.stroke_width(1),
+            ))
+            .map_err(boxed)?
+            .label(format!("ideal ({threads})"))
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        let mut presets: Vec<&str> = ups.iter().map(|s| s.preset.as_str()).collect();
+        presets.dedup();
+        for (i, p) in presets.iter().enumerate() {
+            let c = colour(i);
+            let mut pts: Vec<(f64, f64, f64)> = ups
+                .iter()
+                .filter(|s| s.preset == *p)
+                .map(|s| (s.particles as f64, s.speedup, s.dx))
+                .collect();
+            pts.sort_by(|a, b| a.0.total_cmp(&b.0));
+            chart
+                .draw_series(LineSeries::new(pts.iter().map(|q| (q.0, q.1)), c.stroke_width(2)))
+                .map_err(boxed)?
+                .label(p.to_string())
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+            chart.draw_series(pts.iter().map(|q| Circle::new((q.0, q.1), 4, c.filled()))).map_err(boxed)?;
+            chart
+                .draw_series(
+                    pts.iter().map(|q| {
+                        Text::new(format!("Δx={} ({:.2})", q.2, q.1), (q.0, q.1), ("sans-serif", 11))
+                    }),
+                )
+                .map_err(boxed)?;
+        }
+        legend(&mut chart, SeriesLabelPosition::LowerRight)
+    })
+}

@@ -1,0 +1,183 @@
+//! What `reports/work_precision/results.json` holds.
+
+use super::design::Variant;
+use crate::provenance::Provenance;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// One run of the study. A diverged run is a row with its status and no error value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct RunRow {
+    /// Stable id, e.g. `dx0.02_t2_bicgstab_1e-3-sym-std-xu-fixed`.
+    pub id: String,
+    /// Spacing \[m\].
+    pub dx: f64,
+    /// The option set.
+    #[serde(flatten)]
+    pub variant: Variant,
+    /// `paper` or `tuned` when the option set is one of the case's presets.
+    pub preset: Option<String>,
+    /// Rayon threads of the run.
+    pub threads: usize,
+    /// Parts of the design that asked for the run.
+    pub groups: Vec<String>,
+    /// Particles.
+    pub particles: usize,
+    /// Steps taken.
+    pub steps: usize,
+    /// Time reached \[s\].
+    pub t_end: f64,
+    /// Wall time of the stepping loop \[s\].
+    pub wall_s: f64,
+    /// CPU time of the process (all threads) over the run \[s\], from `/proc/self/stat`:
+    /// `cpu_s / wall_s` well below the thread count means the machine was busy.
+    #[serde(default)]
+    pub cpu_s: Option<f64>,
+    /// Seconds per stage (the solver's `summary.json` `stages`, with `probes` and `guard`).
+    pub stages: BTreeMap<String, f64>,
+    /// Mean PPE iterations per step.
+    pub ppe_iterations_mean: f64,
+    /// Relative error of the semi-axis b (second moments) at the end time, t = 0.008 s,
+    /// against the ellipse ODE (`b_rel_err_final`); `None` when the run diverged.
+    pub b_err: Option<f64>,
+    /// Largest relative b error over the history (`b_rel_err_max`).
+    pub b_err_max: Option<f64>,
+    /// Relative error of the semi-axis a at the end time (`a_rel_err_final`).
+    pub a_err: Option<f64>,
+    /// `ok` or `diverged: <cause at stage, step, time>`.
+    pub status: String,
+}
+
+impl RunRow {
+    /// Whether the run reached its end time.
+    pub fn ok(&self) -> bool {
+        self.status == "ok"
+    }
+
+    /// Wall time per step \[s\] (`None` before the first step).
+    pub fn cost_per_step(&self) -> Option<f64> {
+        (self.steps > 0).then(|| self.wall_s / self.steps as f64)
+    }
+
+    /// Whether the run is `preset` at `dx` with `threads` threads.
+    pub fn is(&self, preset: &str, dx: f64, threads: usize) -> bool {
+        self.preset.as_deref() == Some(preset) && (self.dx - dx).abs() < 1e-12 && self.threads == threads
+    }
+}
+
+/// Cost per step against particle count, `cost = C N^p`, fitted by least squares in
+/// log-log.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CostFit {
+    /// Preset.
+    pub preset: String,
+    /// Threads of the runs fitted.
+    pub threads: usize,
+    /// Fitted exponent p.
+    pub exponent: Option<f64>,
+    /// Fitted constant C \[s\].
+    pub constant: Option<f64>,
+    /// Spacings of the fitted runs, coarse to fine \[m\].
+    pub dx: Vec<f64>,
+    /// Particles of the fitted runs.
+    pub particles: Vec<usize>,
+    /// Seconds per step of the fitted runs.
+    pub cost_per_step_s: Vec<f64>,
+}
+
+/// Wall time with one thread against the main thread count.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpeedUp {
+    /// Preset.
+    pub preset: String,
+    /// Spacing \[m\].
+    pub dx: f64,
+    /// Particles.
+    pub particles: usize,
+    /// Threads of the parallel run.
+    pub threads: usize,
+    /// Wall time with one thread \[s\].
+    pub wall_1_s: f64,
+    /// Wall time with `threads` threads \[s\].
+    pub wall_n_s: f64,
+    /// `wall_1_s / wall_n_s`.
+    pub speedup: f64,
+}
+
+/// One target of the performance issue, evaluated.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Target {
+    /// What is required.
+    pub name: String,
+    /// The measured value (`None` when not measured in this tier).
+    pub value: Option<f64>,
+    /// Unit of `value` and `threshold`.
+    pub unit: String,
+    /// `max` (value ≤ threshold) or `min` (value ≥ threshold).
+    pub kind: String,
+    /// The threshold.
+    pub threshold: f64,
+    /// Pass, fail, or `None` when not evaluated.
+    pub pass: Option<bool>,
+    /// How the value was obtained.
+    pub note: String,
+}
+
+impl Target {
+    /// `PASS`, `FAIL` or `n/a`.
+    pub fn verdict(&self) -> &'static str {
+        match self.pass {
+            Some(true) => "PASS",
+            Some(false) => "FAIL",
+            None => "n/a",
+        }
+    }
+}
+
+/// The machine and build the study ran on.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Machine {
+    /// Git commit, CPU model, logical CPUs, date (UTC).
+    #[serde(flatten)]
+    pub provenance: Provenance,
+    /// `/proc/loadavg` when the study started (other work on the machine skews timings).
+    pub loadavg_start: Option<String>,
+    /// `/proc/loadavg` when it ended.
+    pub loadavg_end: Option<String>,
+}
+
+/// `reports/work_precision/results.json`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Study {
+    /// `work_precision`.
+    pub study: String,
+    /// The case whose scene and reference are used (`elliptical_drop`).
+    pub case: String,
+    /// `quick`, `default` or `full`.
+    pub tier: String,
+    /// False while the study is still running (the file is rewritten after every run).
+    pub complete: bool,
+    /// The error measure of the study.
+    pub error_metric: String,
+    /// Threads of the main runs.
+    pub threads: usize,
+    /// Thread counts of the thread study.
+    pub thread_counts: Vec<usize>,
+    /// The parts of the design.
+    pub design: Vec<String>,
+    /// Machine and build.
+    pub machine: Machine,
+    /// Wall time of the whole study \[s\].
+    pub elapsed_s: f64,
+    /// Every run, in the order run.
+    pub runs: Vec<RunRow>,
+    /// Ids of the runs on the Pareto front of (b error, wall time), main thread count,
+    /// cheapest first.
+    pub pareto: Vec<String>,
+    /// Cost-per-step fits, per preset.
+    pub cost_fits: Vec<CostFit>,
+    /// One-thread against multi-thread wall times.
+    pub speedups: Vec<SpeedUp>,
+    /// The issue's targets.
+    pub targets: Vec<Target>,
+}

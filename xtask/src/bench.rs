@@ -1,0 +1,65 @@
+//! `cargo xtask bench [--quick|--full] [--out DIR] [--threads N]`: the work-precision
+//! study of the elliptical drop into `reports/work_precision/`.
+
+use anyhow::Context;
+use meniscus_harness::Tier;
+use meniscus_harness::work_precision::{self, Options};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+/// Options of `cargo xtask bench`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// Δx 0.04 and 0.02 only, few option sets (about 2 minutes).
+    #[arg(long, conflicts_with = "full")]
+    quick: bool,
+    /// Adds Δx = 0.005 (the full range for the cost-per-step exponent).
+    #[arg(long)]
+    full: bool,
+    /// Output directory [default: <workspace>/reports/work_precision].
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
+    /// Threads of the main runs (the thread study compares 1 with this).
+    #[arg(long, value_name = "N", default_value_t = 2)]
+    threads: usize,
+    /// No line per run.
+    #[arg(long)]
+    no_progress: bool,
+}
+
+/// Runs the study and prints the targets' verdicts; exits 0 even when a target is missed
+/// (the study is a report), 2 when it could not run.
+pub fn run(args: Args) -> anyhow::Result<ExitCode> {
+    let root = crate::workspace_root();
+    let tier = if args.quick {
+        Tier::Quick
+    } else if args.full {
+        Tier::Full
+    } else {
+        Tier::Default
+    };
+    let opts = Options {
+        tier,
+        out: args.out.unwrap_or_else(|| root.join("reports").join("work_precision")),
+        validation_dir: root.join("validation"),
+        workspace: root.clone(),
+        threads: args.threads.max(1),
+        progress: !args.no_progress,
+    };
+    let study = work_precision::run(&opts).context("the work-precision study could not run")?;
+    let diverged = study.runs.iter().filter(|r| !r.ok()).count();
+    eprintln!(
+        "{} runs ({diverged} diverged) in {:.0} s, tier {}, {} threads",
+        study.runs.len(),
+        study.elapsed_s,
+        study.tier,
+        study.threads
+    );
+    for t in &study.targets {
+        let value = t.value.map_or("n/a".to_string(), |v| format!("{v:.3}"));
+        let op = if t.kind == "max" { "<=" } else { ">=" };
+        eprintln!("  {:<4} {}: {value} {} ({op} {}) — {}", t.verdict(), t.name, t.unit, t.threshold, t.note);
+    }
+    eprintln!("report: {}", opts.out.join("index.html").display());
+    Ok(ExitCode::SUCCESS)
+}
