@@ -13,12 +13,14 @@ figure{display:inline-block;margin:0.5em}figcaption{font-size:90%;color:#555}cod
 .better{background:#d9f2d9;color:#145214}.worse{background:#f8d7d7;color:#7a1010}\
 .changed{background:#fff3cd;color:#664d03}.note{color:#555;font-size:90%}";
 
-/// Formats a metric: relative errors and drifts in percent, counts as integers.
+/// Formats a metric: relative errors (`rel_err`, `_l2_rel`, `_linf_rel`) and drifts in
+/// percent, counts as integers.
 pub fn format_metric(name: &str, v: Option<f64>) -> String {
+    let relative = ["rel_err", "_l2_rel", "_linf_rel", "drift"].iter().any(|k| name.contains(k));
     match v {
         None => "—".to_string(),
         Some(x) if !x.is_finite() => "NaN".to_string(),
-        Some(x) if name.contains("rel_err") || name.contains("drift") => format!("{:.3} %", x * 100.0),
+        Some(x) if relative => format!("{:.3} %", x * 100.0),
         Some(x) if x.fract().abs() < 1e-12 && x.abs() < 1e15 => format!("{x:.0}"),
         Some(x) => format!("{x:.4e}"),
     }
@@ -216,7 +218,14 @@ pub(crate) fn resolutions(runs: &[RunResult]) -> String {
     let mut dx: Vec<f64> = runs.iter().map(|r| r.dx).collect();
     dx.sort_by(|a, b| b.total_cmp(a));
     dx.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
-    dx.iter().map(|d| d.to_string()).collect::<Vec<_>>().join(", ")
+    dx.iter().map(|&d| format_dx(d)).collect::<Vec<_>>().join(", ")
+}
+
+/// A spacing as text: as written when short (`0.02`), else to 4 significant digits
+/// (`5.556e-3` for D/36).
+pub fn format_dx(dx: f64) -> String {
+    let plain = dx.to_string();
+    if plain.len() <= 8 { plain } else { format!("{dx:.3e}") }
 }
 
 /// The page of one case; with a comparison, a "Compared with baseline" section follows the
@@ -360,7 +369,7 @@ pub(crate) fn key_errors(results: &CaseResults, record: Option<&CaseRecord>) -> 
             let keys = if keys.is_empty() { run.metrics.keys().take(2).cloned().collect() } else { keys };
             let parts: Vec<String> =
                 keys.iter().map(|k| format!("{k} {}", format_metric(k, run.metric(k)))).collect();
-            format!("{} ({} dx={})", parts.join(", "), run.preset, run.dx)
+            format!("{} ({} dx={})", parts.join(", "), run.preset, format_dx(run.dx))
         }
     }
 }
@@ -436,4 +445,20 @@ pub fn index_page(
         }
     };
     page("Meniscus validation", body)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn metrics_and_spacings_read_well() {
+        assert_eq!(format_metric("u_profile_l2_rel_steady", Some(0.0095)), "0.950 %");
+        assert_eq!(format_metric("b_rel_err_max", Some(0.001)), "0.100 %");
+        assert_eq!(format_metric("particles", Some(648.0)), "648");
+        assert_eq!(format_metric("min_pair_over_dx_min", Some(0.41579)), "4.1579e-1");
+        assert_eq!(format_dx(0.02), "0.02");
+        assert_eq!(format_dx(0.0025), "0.0025");
+        assert_eq!(format_dx(0.2 / 36.0), "5.556e-3");
+    }
 }

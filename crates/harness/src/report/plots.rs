@@ -135,8 +135,12 @@ pub fn history(
             for (j, s) in series.iter().enumerate() {
                 let Some(v) = r.series.get(s) else { continue };
                 let pts = finite_points(&t, v);
-                let label =
-                    format!("{s}, {} dx={}{}", r.preset, r.dx, if r.ok() { "" } else { " (diverged)" });
+                let label = format!(
+                    "{s}, {} dx={}{}",
+                    r.preset,
+                    super::html::format_dx(r.dx),
+                    if r.ok() { "" } else { " (diverged)" }
+                );
                 if j == 0 {
                     chart
                         .draw_series(LineSeries::new(pts, c.stroke_width(2)))
@@ -190,7 +194,11 @@ pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[Str
         for (i, j, pts) in curves {
             let (r, c) = (runs[i], colour(i));
             let [s, reference] = &pairs[j];
-            let label = format!("{s} vs {reference}, dx={}{}", r.dx, if r.ok() { "" } else { " (diverged)" });
+            let label = format!(
+                "{s} vs {reference}, dx={}{}",
+                super::html::format_dx(r.dx),
+                if r.ok() { "" } else { " (diverged)" }
+            );
             let width = if j == 0 { 2 } else { 1 };
             let series = if j == 0 {
                 chart.draw_series(LineSeries::new(pts, c.stroke_width(width))).map_err(boxed)?
@@ -323,9 +331,9 @@ pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Resul
                 .label(p.to_string())
                 .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
             chart
-                .draw_series(
-                    mine.iter().map(|q| Text::new(format!("dx={}", q.1), (q.2, q.3), ("sans-serif", 12))),
-                )
+                .draw_series(mine.iter().map(|q| {
+                    Text::new(format!("dx={}", super::html::format_dx(q.1)), (q.2, q.3), ("sans-serif", 12))
+                }))
                 .map_err(boxed)?;
         }
         legend(&mut chart, SeriesLabelPosition::UpperRight)?;
