@@ -8,29 +8,12 @@
 use super::record::{CostFit, RunRow, SpeedUp};
 use super::targets::thresholds;
 use crate::error::{HarnessError, Result};
+use crate::report::plots::colour;
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
 /// Figure size in pixels.
 const SIZE: (u32, u32) = (820, 480);
-
-/// Category colours.
-const PALETTE: [RGBColor; 10] = [
-    RGBColor(31, 119, 180),
-    RGBColor(255, 127, 14),
-    RGBColor(44, 160, 44),
-    RGBColor(214, 39, 40),
-    RGBColor(148, 103, 189),
-    RGBColor(140, 86, 75),
-    RGBColor(227, 119, 194),
-    RGBColor(127, 127, 127),
-    RGBColor(188, 189, 34),
-    RGBColor(23, 190, 207),
-];
-
-fn colour(i: usize) -> RGBColor {
-    PALETTE[i % PALETTE.len()]
-}
 
 type DrawResult = std::result::Result<(), Box<dyn std::fmt::Debug>>;
 
