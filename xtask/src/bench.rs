@@ -2,7 +2,6 @@
 //! study of the elliptical drop into `reports/work_precision/`.
 
 use anyhow::Context;
-use meniscus_harness::Tier;
 use meniscus_harness::work_precision::{self, Options};
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -31,13 +30,7 @@ pub struct Args {
 /// (the study is a report), 2 when it could not run.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let root = crate::workspace_root();
-    let tier = if args.quick {
-        Tier::Quick
-    } else if args.full {
-        Tier::Full
-    } else {
-        Tier::Default
-    };
+    let tier = crate::tier(args.quick, args.full);
     let opts = Options {
         tier,
         out: args.out.unwrap_or_else(|| root.join("reports").join("work_precision")),

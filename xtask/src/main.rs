@@ -52,3 +52,15 @@ fn workspace_root() -> PathBuf {
     let manifest = PathBuf::from(env!("CARGO_MANIFEST_DIR"));
     manifest.parent().map(PathBuf::from).unwrap_or(manifest)
 }
+
+/// The tier named by a command's `--quick` / `--full` flags (neither: the default tier).
+fn tier(quick: bool, full: bool) -> meniscus_harness::Tier {
+    use meniscus_harness::Tier;
+    if quick {
+        Tier::Quick
+    } else if full {
+        Tier::Full
+    } else {
+        Tier::Default
+    }
+}

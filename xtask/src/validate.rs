@@ -2,7 +2,7 @@
 //! [--baseline DIR]`.
 
 use anyhow::Context;
-use meniscus_harness::{Tier, ValidateOptions};
+use meniscus_harness::ValidateOptions;
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -40,13 +40,7 @@ pub struct Args {
 /// Runs the validation; the exit code is 0 only when every check passes.
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let root = crate::workspace_root();
-    let tier = if args.quick {
-        Tier::Quick
-    } else if args.full {
-        Tier::Full
-    } else {
-        Tier::Default
-    };
+    let tier = crate::tier(args.quick, args.full);
     let opts = ValidateOptions {
         tier,
         cases: args.cases,

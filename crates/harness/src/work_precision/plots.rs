@@ -17,6 +17,16 @@ const SIZE: (u32, u32) = (820, 480);
 
 type DrawResult = std::result::Result<(), Box<dyn std::fmt::Debug>>;
 
+/// A chart with the page's caption font, margin and label areas (every figure here).
+fn chart_builder<'a, 'b>(
+    root: &'a DrawingArea<SVGBackend<'b>, Shift>,
+    caption: impl AsRef<str>,
+) -> ChartBuilder<'a, 'b, SVGBackend<'b>> {
+    let mut b = ChartBuilder::on(root);
+    b.caption(caption, ("sans-serif", 18)).margin(12).x_label_area_size(42).y_label_area_size(64);
+    b
+}
+
 fn boxed<E: std::fmt::Debug + 'static>(e: E) -> Box<dyn std::fmt::Debug> {
     Box::new(e)
 }
@@ -87,11 +97,7 @@ pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<
     let rows: Vec<&RunRow> = pts.iter().map(|p| p.0).collect();
     let dxs = spacings(&rows);
     svg(file, |root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption("Work-precision: wall time against b error at t = 0.008 s", ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(42)
-            .y_label_area_size(64)
+        let mut chart = chart_builder(root, "Work-precision: wall time against b error at t = 0.008 s")
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(boxed)?;
         chart
@@ -225,11 +231,7 @@ pub fn cost_scaling(file: &str, fits: &[CostFit], one_thread: &[&RunRow]) -> Res
         2.0,
     );
     svg(file, |root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption("Cost per step against particle count", ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(42)
-            .y_label_area_size(64)
+        let mut chart = chart_builder(root, "Cost per step against particle count")
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(boxed)?;
         chart
@@ -281,11 +283,7 @@ pub fn speedup(file: &str, ups: &[SpeedUp], threads: usize) -> Result<String> {
     let (x0, x1) = log_range(ups.iter().map(|s| s.particles as f64), 1.5);
     let top = ups.iter().map(|s| s.speedup).fold(threads as f64, f64::max) * 1.15;
     svg(file, |root| {
-        let mut chart = ChartBuilder::on(root)
-            .caption(format!("Speed-up, 1 → {threads} threads"), ("sans-serif", 18))
-            .margin(12)
-            .x_label_area_size(42)
-            .y_label_area_size(64)
+        let mut chart = chart_builder(root, format!("Speed-up, 1 → {threads} threads"))
             .build_cartesian_2d((x0..x1).log_scale(), 0.0..top)
             .map_err(boxed)?;
         chart
