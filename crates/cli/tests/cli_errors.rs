@@ -148,7 +148,7 @@ fn diverged_run_writes_the_last_good_state() {
     // Δt 100 times the CFL limit: the run blows up within a few steps.
     let scene = small_scene(&dir, |v| {
         v["dx"] = serde_json::json!(0.04);
-        v["time"] = serde_json::json!({"end": 0.008, "step": {"fixed": 2e-3}});
+        v["time"] = serde_json::json!({"end": 0.1, "step": {"fixed": 2e-2}});
     });
     let out = dir.join("out");
     let res = meniscus(&["run", s(&scene), "--out", s(&out), "--vtk-every", "1"]);

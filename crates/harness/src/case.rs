@@ -151,6 +151,15 @@ pub enum ReferenceSpec {
         /// Density \[kg/m^3\].
         density: f64,
     },
+    /// Laminar entrance flow from a uniform inlet (`meniscus_reference::entrance_flow`);
+    /// inflow speed, inlet position, viscosity and the station (the slab of the cross
+    /// profile probe) come from each run's scene.
+    EntranceFlow {
+        /// Channel width D \[m\].
+        width: f64,
+        /// Position of the lower wall \[m\].
+        wall: f64,
+    },
     /// Plane Poiseuille start-up from rest (`meniscus_reference::poiseuille`); viscosity and
     /// body force come from each run's scene.
     PoiseuilleStartup {
@@ -165,8 +174,8 @@ pub enum ReferenceSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case", deny_unknown_fields)]
 pub enum Figure {
-    /// Time histories of run series against a reference series: one figure per preset,
-    /// one colour per resolution, one dash style per series.
+    /// Time histories (or profiles, with `x`) of run series against a reference series: one
+    /// figure per preset, one colour per resolution, one dash style per series.
     History {
         /// File stem (`<file>_<preset>.svg`).
         file: String,
@@ -181,6 +190,13 @@ pub enum Figure {
         /// Reference series (drawn once, from the finest run, in black).
         #[serde(default)]
         reference: Option<String>,
+        /// Abscissa: a run series (e.g. `x_over_d` for a profile along a channel); absent:
+        /// time `t`.
+        #[serde(default)]
+        x: Option<String>,
+        /// x-axis label (absent: `t [s]`, or the abscissa series' name).
+        #[serde(default)]
+        x_label: Option<String>,
     },
     /// Error against dx in log-log, one line per metric and preset, with the fitted order
     /// and a reference slope.

@@ -169,6 +169,11 @@ impl<const D: usize> ProbeSet<D> {
                         out.push(key, &format!("u_{k:03}"), v);
                     }
                 }
+                Probe::MassBalance {} => {
+                    out.push(key, "mass", mass * nf as f64);
+                    out.push(key, "inflow", s.flux.inflow);
+                    out.push(key, "outflow", s.flux.outflow);
+                }
                 Probe::Solver {} => {
                     out.push(key, "free_surface_count", s.free_surface.iter().filter(|&&f| f).count() as f64);
                     out.push(key, "iterations", s.ppe.info.iterations as f64);
@@ -208,5 +213,6 @@ pub fn kind_name(p: &Probe) -> &'static str {
         Probe::Disorder {} => "disorder",
         Probe::Solver {} => "solver",
         Probe::VelocityProfile { .. } => "velocity_profile",
+        Probe::MassBalance {} => "mass_balance",
     }
 }

@@ -8,6 +8,7 @@ use crate::probes::{ProbeRecord, ProbeSet, Weight};
 use crate::scene::{KernelKind, Role, Scene, Scheme, TimeStep, WallModel, lattice};
 use crate::stage::{Stage, StepContext};
 use crate::stages::dummy::dummy_layers;
+use crate::stages::open_boundary::{OpenSetup, Openings};
 use crate::state::{Particles, State, Vector};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -253,6 +254,20 @@ impl<const D: usize> Simulation<D> {
             domain.wrap(x);
         }
         check_seeds(&particles, &body_start, scene.dx, domain)?;
+        let h = scene.h();
+        let support = match scene.kernel.kind {
+            KernelKind::CubicSpline => Scaled::<CubicSpline, D>::new(h).support,
+            KernelKind::WendlandC2 => Scaled::<WendlandC2, D>::new(h).support,
+        };
+        let open = match (&scene.boundaries.inflow, &scene.boundaries.outflow) {
+            (Some(i), Some(o)) => {
+                let openings = Openings::new(i, o, scene.dx, support);
+                let (inlet, link) = openings.seed(&mut particles)?;
+                Some(OpenSetup { openings, inlet, next_id: particles.fluid as u32, link })
+            }
+            _ => None,
+        };
+        let buffer = particles.total() - particles.fluid;
         if scene.boundaries.wall_model == WallModel::Dummy && !scene.boundaries.walls.is_empty() {
             let depth = 2.0 * scene.h();
             for x in dummy_layers(&scene.boundaries.walls, &domain, &particles.x, scene.dx, depth) {
@@ -269,7 +284,6 @@ impl<const D: usize> Simulation<D> {
         }
         let margin = 4.0 * (hi - lo).max().max(10.0 * scene.dx);
         let bounds = (lo.add_scalar(-margin), hi.add_scalar(margin));
-        let h = scene.h();
         let n = particles.len();
         let state = State {
             particles,
@@ -286,10 +300,13 @@ impl<const D: usize> Simulation<D> {
             domain,
             ppe: Default::default(),
             mirrors: Default::default(),
+            buffer,
+            flux: Default::default(),
+            inlet: open.as_ref().map(|o| o.link.clone()).unwrap_or_default(),
         };
         let (stages, weight) = match scene.kernel.kind {
-            KernelKind::CubicSpline => build::<CubicSpline, D>(scene, h, domain),
-            KernelKind::WendlandC2 => build::<WendlandC2, D>(scene, h, domain),
+            KernelKind::CubicSpline => build::<CubicSpline, D>(scene, h, domain, open.as_ref()),
+            KernelKind::WendlandC2 => build::<WendlandC2, D>(scene, h, domain, open.as_ref()),
         };
         let neighbour_band = NeighbourBand::new::<D>(weight.support, scene.dx);
         Ok(Self {
@@ -532,7 +549,8 @@ impl<const D: usize> Simulation<D> {
     }
 }
 
-/// `particles` (with their free-surface flags) in initial-id order.
+/// The fluid of `particles` (with their free-surface flags) in id order (initial order;
+/// particles that entered through an inlet follow in order of entry).
 fn frame_of<const D: usize>(p: &Particles<D>, free_surface: &[bool], step: usize, time: f64) -> Frame {
     let n = p.len();
     let mut f = Frame {
@@ -543,8 +561,9 @@ fn frame_of<const D: usize>(p: &Particles<D>, free_surface: &[bool], step: usize
         p: vec![0.0; n],
         free_surface: vec![false; n],
     };
-    for a in 0..n {
-        let i = p.id[a] as usize;
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_unstable_by_key(|&a| p.id[a]);
+    for (i, &a) in order.iter().enumerate() {
         for k in 0..D.min(3) {
             f.x[i][k] = p.x[a][k];
             f.u[i][k] = p.u[a][k];
@@ -612,10 +631,11 @@ fn build<K: Kernel, const D: usize>(
     scene: &Scene,
     h: f64,
     domain: Domain<D>,
+    open: Option<&OpenSetup>,
 ) -> (Vec<Box<dyn Stage<D>>>, Weight) {
     let kernel = Scaled::<K, D>::new(h);
     let stages = match &scene.scheme {
-        Scheme::Isph(opts) => crate::isph::build_stages::<K, D>(scene, opts, kernel, domain),
+        Scheme::Isph(opts) => crate::isph::build_stages::<K, D>(scene, opts, kernel, domain, open),
     };
     (stages, Weight { w: Box::new(move |r| kernel.w(r)), support: kernel.support })
 }

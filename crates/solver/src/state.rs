@@ -7,7 +7,8 @@ use nalgebra::SVector;
 pub type Vector<const D: usize> = SVector<f64, D>;
 
 /// Particles, structure of arrays: the `fluid` fluid particles first, then the boundary
-/// particles (wall mirrors, rebuilt every step) which only enter neighbour sums. Fluid
+/// particles which only enter neighbour sums: open-boundary buffers ([`State::buffer`] of
+/// them), then wall mirrors (rebuilt every step) or dummy wall particles. Fluid
 /// particles are reordered by cell for locality; `id` keeps each one's index in the initial
 /// order.
 #[derive(Debug, Clone, Default)]
@@ -88,8 +89,39 @@ pub struct State<const D: usize> {
     pub domain: Domain<D>,
     /// The assembled pressure Poisson system of the current step.
     pub ppe: PpeSystem,
-    /// Where each boundary particle's values come from.
+    /// Where each mirror particle's values come from.
     pub mirrors: Mirrors,
+    /// Number of open-boundary buffer particles, stored right after the fluid (inlet
+    /// buffer first, then outlet buffer); mirrors or dummy wall particles follow them.
+    pub buffer: usize,
+    /// Cumulative masses through the open boundaries.
+    pub flux: Flux,
+    /// Where the inlet buffer takes its pressure from.
+    pub inlet: InletLink,
+}
+
+/// The inlet buffer's pressure link (zero normal gradient at the inlet): every buffer
+/// particle of lattice row `r` shares the PPE unknown of the fluid particle that entered
+/// last through that row, the fluid particle next to the inlet plane.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct InletLink {
+    /// Buffer columns: inlet buffer particle `i` is in row `i / columns`.
+    pub columns: usize,
+    /// Id of the fluid particle that entered last through each row.
+    pub row_id: Vec<u32>,
+    /// Current index of the source of each inlet buffer particle (`u32::MAX`: none found;
+    /// the buffer particle then keeps its pressure as a known value).
+    pub source: Vec<u32>,
+}
+
+/// Cumulative masses that crossed the inlet and the outlet \[kg, per metre of depth in
+/// 2D\].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Flux {
+    /// Mass that entered through the inlet.
+    pub inflow: f64,
+    /// Mass that left through the outlet.
+    pub outflow: f64,
 }
 
 /// Boundary particles that mirror fluid particles: boundary particle `fluid + k` takes its
@@ -122,6 +154,12 @@ pub struct PpeSystem {
 }
 
 impl<const D: usize> State<D> {
+    /// Index of the first wall particle (mirror or dummy): after the fluid and the
+    /// open-boundary buffers.
+    pub fn walls_start(&self) -> usize {
+        self.particles.fluid + self.buffer
+    }
+
     /// Largest fluid particle speed \[m/s\] (order-independent reduction).
     pub fn max_speed(&self) -> f64 {
         self.particles.u[..self.particles.fluid].iter().map(|u| u.norm_squared()).fold(0.0, f64::max).sqrt()

@@ -6,6 +6,7 @@
 //! `<quantity>_rel_err_final` (at the last sample), `<quantity>_drift` (largest
 //! `|x(t) - x(0)| / |x(0)|`). Non-finite samples make the norm NaN (never silently skipped).
 
+pub mod channel;
 pub mod elliptical_drop;
 pub mod poiseuille;
 pub mod rotating_square;
@@ -37,6 +38,9 @@ pub fn compute(
         }
         ReferenceSpec::PoiseuilleStartup { width, wall } => {
             poiseuille::compute(&poiseuille::channel(width, scene)?, wall, probes)?
+        }
+        ReferenceSpec::EntranceFlow { width, wall } => {
+            channel::compute(&channel::Channel::new(width, wall, scene)?, probes)?
         }
         ReferenceSpec::RotatingSquare { side, omega, density } => {
             let patch = meniscus_reference::rotating_square::RotatingSquare::new(side, omega, density)?;

@@ -45,9 +45,13 @@ pub fn render_case(
     }
     for fig in record.map(|r| r.case.figures.as_slice()).unwrap_or(&[]) {
         match fig {
-            Figure::History { file, title, y_label, series, reference } => {
+            Figure::History { file, title, y_label, series, reference, x, x_label } => {
+                let x = x.as_deref().unwrap_or("t");
+                let x_label =
+                    x_label.clone().unwrap_or_else(|| if x == "t" { "t [s]".into() } else { x.into() });
                 per_preset(case_dir, &runs, &presets, file, title, &mut figures, |name, caption, mine| {
-                    plots::history(name, caption, y_label, mine, series, reference.as_deref())
+                    let axes = plots::Axes { x, x_label: &x_label, y_label };
+                    plots::history(name, caption, &axes, mine, series, reference.as_deref())
                 })?;
             }
             Figure::ErrorHistory { file, title, pairs } => {

@@ -96,17 +96,29 @@ fn boxed<E: std::fmt::Debug + 'static>(e: E) -> Box<dyn std::fmt::Debug> {
     Box::new(e)
 }
 
-/// Time histories: `series` of every run (one colour per run, solid for the first series,
-/// dashed for the others) and the `reference` series of the finest run in black.
+/// The abscissa series of a [`history`] figure and the axis labels.
+#[derive(Debug, Clone, Copy)]
+pub struct Axes<'a> {
+    /// Run series on the x axis (`t` for a time history).
+    pub x: &'a str,
+    /// x-axis label.
+    pub x_label: &'a str,
+    /// y-axis label.
+    pub y_label: &'a str,
+}
+
+/// Time histories (or profiles): `series` of every run against the `axes.x` series (one
+/// colour per run, solid for the first series, dashed for the others) and the `reference`
+/// series of the finest run in black.
 pub fn history(
     file: &str,
     title: &str,
-    y_label: &str,
+    axes: &Axes<'_>,
     runs: &[&RunResult],
     series: &[String],
     reference: Option<&str>,
 ) -> Result<String> {
-    let t_of = |r: &RunResult| r.series.get("t").cloned().unwrap_or_default();
+    let t_of = |r: &RunResult| r.series.get(axes.x).cloned().unwrap_or_default();
     let mut all_y = Vec::new();
     let mut all_t = Vec::new();
     for r in runs {
@@ -120,7 +132,7 @@ pub fn history(
     let finest = runs.iter().filter(|r| r.ok()).min_by(|a, b| a.dx.total_cmp(&b.dx)).or(runs.first());
     svg(|root| {
         let mut chart = builder(root, title).build_cartesian_2d(t0..t1, y0..y1).map_err(boxed)?;
-        chart.configure_mesh().x_desc("t [s]").y_desc(y_label).draw().map_err(boxed)?;
+        chart.configure_mesh().x_desc(axes.x_label).y_desc(axes.y_label).draw().map_err(boxed)?;
         if let (Some(r), Some(name)) = (finest, reference)
             && let Some(v) = r.series.get(name)
         {

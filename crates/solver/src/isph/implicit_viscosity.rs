@@ -49,10 +49,17 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
         let n = s.particles.fluid;
         let (list, pairs) = (&s.neighbours, &s.pairs);
         let (eta2, c) = (0.01 * s.h * s.h, ctx.dt * self.nu * 2.0 * s.volume);
-        let (source, sign) = (&s.mirrors.source, &s.mirrors.sign);
-        // The unknown a neighbour couples to, with its factor (None: known value).
+        let (source, sign, start) = (&s.mirrors.source, &s.mirrors.sign, s.walls_start());
+        // The unknown a neighbour couples to, with its factor (None: a known value, as for
+        // open-boundary buffers, dummy wall particles and the mirrors of buffers).
         let column = |b: usize| -> Option<(u32, f64)> {
-            if b < n { Some((b as u32, 1.0)) } else { source.get(b - n).map(|&src| (src, sign[b - n])) }
+            if b < n {
+                Some((b as u32, 1.0))
+            } else if b < start {
+                None
+            } else {
+                source.get(b - start).filter(|&&src| (src as usize) < n).map(|&src| (src, sign[b - start]))
+            }
         };
         let m = &mut self.matrix;
         m.row_ptr.resize(n + 1, 0);

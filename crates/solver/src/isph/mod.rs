@@ -3,12 +3,13 @@
 //! The step, built from the scene (a stage the scene does not need is not built):
 //! `reorder` (locality) → `advect` (eq. 3) → `walls` (§2.4.2; mirror walls only) →
 //! `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation) →
-//! `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
+//! `inlet_sources` (inflow only) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
 //! (eq. 4; g ≠ 0 only) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
 //! `mirror_velocity` | `dummy_velocity` (walls only) → `ppe_assemble`
 //! (eqs. 10, 12) → `ppe_solve` (eq. 5) → `dummy_pressure` (dummy walls only) →
-//! `correction` (eqs. 6, 15) → `position` (eq. 7) → `shifting` (eqs. 20–21; when
-//! configured).
+//! `correction` (eqs. 6, 15) → `position` (eq. 7) →
+//! `shifting` (eqs. 20–21; when configured) → `open_boundaries` (inflow/outflow only:
+//! buffer transfer).
 
 pub mod implicit_viscosity;
 pub mod predictor;
@@ -21,18 +22,44 @@ use crate::scene::{IsphOptions, Scene, Shifting as ShiftSpec};
 use crate::scene::{ViscousIntegration, WallModel};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
-use crate::stages::{free_surface::FreeSurface, neighbours::Neighbours, reorder::Reorder, walls};
+use crate::stages::neighbours::{Neighbours, Rows};
+use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
+use crate::stages::{free_surface::FreeSurface, reorder::Reorder, walls};
 use crate::state::Vector;
 
 /// Particles are reordered by cell every this many steps.
 const REORDER_EVERY: usize = 25;
 
-/// Builds the ISPH stage list for `scene`.
+/// `div r = −Σ_b V r_ab·∇_aW_ab` (Qiu eq. 16) at a point of the cell-centred lattice of
+/// spacing `V^(1/D)` with every lattice point within the support as a neighbour.
+fn lattice_div_r<K: Kernel, const D: usize>(kernel: &Scaled<K, D>, volume: f64) -> f64 {
+    let dx = volume.powf(1.0 / D as f64);
+    let n = (kernel.support / dx).ceil() as i64;
+    let mut idx = [-n; D];
+    let mut sum = 0.0;
+    'all: loop {
+        let r2 = idx.iter().map(|&i| (i as f64 * dx).powi(2)).sum::<f64>();
+        if r2 > 0.0 {
+            sum -= volume * kernel.grad_factor(r2.sqrt()) * r2;
+        }
+        for i in idx.iter_mut() {
+            if *i < n {
+                *i += 1;
+                continue 'all;
+            }
+            *i = -n;
+        }
+        return sum;
+    }
+}
+
+/// Builds the ISPH stage list for `scene` (`open`: its inflow/outflow, when it has them).
 pub fn build_stages<K: Kernel, const D: usize>(
     scene: &Scene,
     opts: &IsphOptions,
     kernel: Scaled<K, D>,
     domain: crate::neighbours::Domain<D>,
+    open: Option<&OpenSetup>,
 ) -> Vec<Box<dyn Stage<D>>> {
     let mut stages: Vec<Box<dyn Stage<D>>> =
         vec![Box::new(Reorder::new(kernel.support, domain, REORDER_EVERY)), Box::new(predictor::Advect)];
@@ -41,9 +68,13 @@ pub fn build_stages<K: Kernel, const D: usize>(
     if walls == Some(WallModel::Mirror) {
         stages.push(Box::new(walls::Walls::new(&scene.boundaries.walls, kernel.support)));
     }
-    stages.push(Box::new(Neighbours::new(kernel, domain, walls == Some(WallModel::Dummy))));
+    let rows = if walls == Some(WallModel::Dummy) { Rows::All } else { Rows::Fluid };
+    stages.push(Box::new(Neighbours::new(kernel, domain, rows)));
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Start)));
+    }
+    if open.is_some() {
+        stages.push(Box::new(InletSources));
     }
     stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold }));
     // Explicit: u* = uⁿ + Δt ν L(uⁿ), then + Δt g. Implicit: uⁿ + Δt g first, then the
@@ -64,7 +95,9 @@ pub fn build_stages<K: Kernel, const D: usize>(
         Some(WallModel::Dummy) => stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Velocity))),
         None => {}
     }
-    stages.push(Box::new(projection::PpeAssemble { divergence: opts.divergence }));
+    let relaxation = (opts.density_relaxation > 0.0)
+        .then(|| (opts.density_relaxation, lattice_div_r(&kernel, scene.dx.powi(D as i32))));
+    stages.push(Box::new(projection::PpeAssemble { divergence: opts.divergence, relaxation, dt_max: 0.0 }));
     stages.push(Box::new(projection::PpeSolveStage { solver: PpeSolve::new(opts.ppe) }));
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Pressure)));
@@ -83,6 +116,9 @@ pub fn build_stages<K: Kernel, const D: usize>(
             kernel,
             opts.free_surface_threshold,
         ))),
+    }
+    if let Some(o) = open {
+        stages.push(Box::new(OpenBoundaries::new(o)));
     }
     stages
 }

@@ -185,6 +185,39 @@ pub struct Boundaries {
     /// How walls are represented.
     #[serde(default)]
     pub wall_model: WallModel,
+    /// A uniform-velocity inlet (with `outflow`; none: no open-boundary stage is built).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub inflow: Option<Inflow>,
+    /// An outlet downstream of `inflow`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub outflow: Option<Outflow>,
+}
+
+/// A uniform-velocity inlet: the plane `x[axis] = position`, the flow entering towards
+/// `+axis` at `velocity` through a buffer of particles upstream of the plane (the fluid's
+/// first lattice column repeated upstream over the kernel support), moving at `velocity`
+/// and turned into fluid particles as they cross the plane.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Inflow {
+    /// Axis of the flow (0 = x).
+    pub axis: usize,
+    /// Position of the inlet plane \[m\].
+    pub position: f64,
+    /// Inflow speed U along `+axis` \[m/s\] (> 0).
+    pub velocity: f64,
+}
+
+/// An outlet: the plane `x[axis] = position`; fluid particles crossing it join a buffer
+/// downstream that keeps their normal velocity and zero pressure (a Dirichlet `p = 0`
+/// outlet), and leave when they are a kernel support past the plane.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Outflow {
+    /// Axis of the flow (the inflow's).
+    pub axis: usize,
+    /// Position of the outlet plane \[m\] (downstream of the inlet).
+    pub position: f64,
 }
 
 /// A plane no-slip wall at rest, normal to a coordinate axis: `x[axis] = position`, the
@@ -262,6 +295,12 @@ pub struct IsphOptions {
     /// Form of the velocity divergence on the PPE right-hand side.
     #[serde(default)]
     pub divergence: Divergence,
+    /// Coefficient α ∈ [0, 1] of the density-relaxation term added to the PPE source
+    /// (0, the default: none; see `isph::projection::PpeAssemble`). A divergence-free
+    /// projection does not restore a drifted particle density; in a closed or periodic
+    /// domain the volume is fixed, but through an open boundary the fluid can compress.
+    #[serde(default)]
+    pub density_relaxation: f64,
     /// Time integration of the viscous term.
     #[serde(default)]
     pub viscosity: ViscousIntegration,
@@ -398,6 +437,10 @@ pub enum Probe {
     Disorder {},
     /// Free-surface particle count `count`, PPE iterations `iterations` and residual `residual`.
     Solver {},
+    /// Mass balance of an open channel (`boundaries.inflow`): the fluid mass in the domain
+    /// `mass` and the cumulative masses that entered, `inflow`, and left, `outflow`
+    /// \[kg, per metre of depth in 2D\].
+    MassBalance {},
     /// Velocity profile across a channel: the fluid in `range` along `axis` (optionally only
     /// where `slab.axis` lies in `slab.range`) is split into equal bins; each bin
     /// records the mean position `y_###` \[m\] and the mean velocity component `u_###`

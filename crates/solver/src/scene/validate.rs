@@ -222,6 +222,14 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
             "must be below the dimension (div r is about D in the bulk)",
         ));
     }
+    let alpha = o.density_relaxation;
+    if !(alpha.is_finite() && (0.0..=1.0).contains(&alpha)) {
+        return Err(SceneError::new(
+            "scheme.isph.density_relaxation",
+            alpha,
+            "must lie in [0, 1] (0: off; 0.01–0.1 relaxes a density drift over 10–100 steps)",
+        ));
+    }
     match o.shifting {
         Shifting::None => {}
         Shifting::Xu { coefficient } => {

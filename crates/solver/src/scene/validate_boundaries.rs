@@ -1,13 +1,15 @@
-//! Value checks of walls, velocity profiles and probe times (split from `validate` to keep
+//! Value checks of walls, inflow/outflow, velocity profiles and probe times (split from `validate` to keep
 //! each file about one part of the scene). Every rule names the field, the value and the
 //! rule.
 
 use super::schema::*;
 use crate::error::SceneError;
 
-/// Checks `boundaries.walls`, the `velocity_profile` probes and `output.probe_times`.
+/// Checks `boundaries.walls`, `boundaries.inflow`/`outflow`, the `velocity_profile` probes
+/// and `output.probe_times`.
 pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
     let d = scene.dimension;
+    open_boundaries(scene)?;
     for (i, wall) in scene.boundaries.walls.iter().enumerate() {
         let f = format!("boundaries.walls[{i}]");
         axis(&format!("{f}.axis"), wall.axis, d)?;
@@ -52,6 +54,74 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
             return Err(SceneError::new(f, t, "must not exceed time.end"));
         }
         last = t;
+    }
+    Ok(())
+}
+
+/// An inflow needs an outflow on the same axis downstream of it (and the reverse), a
+/// positive inflow speed, a non-periodic axis and mirror walls (dummy wall layers are laid
+/// once over the initial fluid and would not cover the buffers).
+fn open_boundaries(scene: &Scene) -> Result<(), SceneError> {
+    let b = &scene.boundaries;
+    let (inflow, outflow) = match (&b.inflow, &b.outflow) {
+        (None, None) => return Ok(()),
+        (Some(_), None) => {
+            return Err(SceneError::new(
+                "boundaries.outflow",
+                "absent",
+                "is required with an inflow (the mass entering must be able to leave)",
+            ));
+        }
+        (None, Some(_)) => {
+            return Err(SceneError::new("boundaries.inflow", "absent", "is required with an outflow"));
+        }
+        (Some(i), Some(o)) => (i, o),
+    };
+    axis("boundaries.inflow.axis", inflow.axis, scene.dimension)?;
+    finite("boundaries.inflow.position", inflow.position)?;
+    finite("boundaries.inflow.velocity", inflow.velocity)?;
+    if inflow.velocity <= 0.0 {
+        return Err(SceneError::new(
+            "boundaries.inflow.velocity",
+            inflow.velocity,
+            "must be positive (the flow enters towards +axis)",
+        ));
+    }
+    if outflow.axis != inflow.axis {
+        return Err(SceneError::new(
+            "boundaries.outflow.axis",
+            outflow.axis,
+            "must equal boundaries.inflow.axis",
+        ));
+    }
+    finite("boundaries.outflow.position", outflow.position)?;
+    if outflow.position <= inflow.position {
+        return Err(SceneError::new(
+            "boundaries.outflow.position",
+            outflow.position,
+            "must lie downstream of (above) boundaries.inflow.position",
+        ));
+    }
+    if b.periodic.iter().any(|p| p.axis == inflow.axis) {
+        return Err(SceneError::new(
+            "boundaries.inflow.axis",
+            inflow.axis,
+            "is also a periodic axis (a flow cannot both enter and wrap around)",
+        ));
+    }
+    if b.walls.iter().any(|w| w.axis == inflow.axis) {
+        return Err(SceneError::new(
+            "boundaries.inflow.axis",
+            inflow.axis,
+            "is also the normal of a wall (walls must run along the flow)",
+        ));
+    }
+    if b.wall_model == WallModel::Dummy && !b.walls.is_empty() {
+        return Err(SceneError::new(
+            "boundaries.wall_model",
+            "dummy",
+            "is not supported with inflow/outflow yet (use mirror walls)",
+        ));
     }
     Ok(())
 }

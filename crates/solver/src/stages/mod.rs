@@ -1,8 +1,10 @@
-//! Stages shared by every scheme: reordering, walls (mirror and dummy particles), neighbour search with the pair cache,
-//! free-surface detection.
+//! Stages shared by every scheme: reordering, walls (mirror and dummy particles), open
+//! boundaries (inflow/outflow buffers), neighbour search with the pair cache, free-surface
+//! detection.
 
 pub mod dummy;
 pub mod free_surface;
 pub mod neighbours;
+pub mod open_boundary;
 pub mod reorder;
 pub mod walls;

@@ -6,22 +6,29 @@ use crate::neighbours::CellSearch;
 use crate::stage::{Stage, StepContext, par_rows_mut};
 use crate::state::{Pair, State};
 
-/// Rebuilds the neighbour lists of the fluid particles at the current positions (their
-/// neighbours include boundary particles; dummy wall particles get rows too) and fills the pair cache (`r_ab`, `r²`,
-/// `W'(r)/r`).
+/// Which particles get a neighbour row (every particle is found as a neighbour).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Rows {
+    /// The fluid only.
+    Fluid,
+    /// Every particle (dummy walls extrapolate from their fluid neighbours).
+    All,
+}
+
+/// Rebuilds the neighbour lists at the current positions (rows for the particles `rows`
+/// selects; their neighbours include boundary particles) and fills the pair cache (`r_ab`,
+/// `r²`, `W'(r)/r`).
 #[derive(Debug)]
 pub struct Neighbours<K: Kernel, const D: usize> {
     search: CellSearch<D>,
     kernel: Scaled<K, D>,
-    boundary_rows: bool,
+    rows: Rows,
 }
 
 impl<K: Kernel, const D: usize> Neighbours<K, D> {
-    /// A stage for `kernel` in `domain`; search radius = kernel support. With
-    /// `boundary_rows` the boundary particles get neighbour rows too (dummy walls
-    /// extrapolate from their fluid neighbours).
-    pub fn new(kernel: Scaled<K, D>, domain: crate::neighbours::Domain<D>, boundary_rows: bool) -> Self {
-        Self { search: CellSearch::new(kernel.support, domain), kernel, boundary_rows }
+    /// A stage for `kernel` in `domain`; search radius = kernel support.
+    pub fn new(kernel: Scaled<K, D>, domain: crate::neighbours::Domain<D>, rows: Rows) -> Self {
+        Self { search: CellSearch::new(kernel.support, domain), kernel, rows }
     }
 }
 
@@ -31,7 +38,10 @@ impl<K: Kernel, const D: usize> Stage<D> for Neighbours<K, D> {
     }
 
     fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
-        let rows = if self.boundary_rows { s.particles.total() } else { s.particles.fluid };
+        let rows = match self.rows {
+            Rows::Fluid => s.particles.fluid,
+            Rows::All => s.particles.total(),
+        };
         self.search.build_rows(&s.particles.x, rows, &mut s.neighbours);
         let n_pairs = s.neighbours.pairs();
         s.pairs.resize(n_pairs, Pair::default());

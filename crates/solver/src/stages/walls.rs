@@ -41,7 +41,9 @@ impl<const D: usize> Stage<D> for Walls {
     }
 
     fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
-        let nf = s.particles.fluid;
+        // Fluid and open-boundary buffers are mirrored (a buffer near a wall needs its
+        // mirrors as much as the fluid does).
+        let nf = s.walls_start();
         let p = &mut s.particles;
         p.x.truncate(nf);
         p.u.truncate(nf);
@@ -106,8 +108,8 @@ impl<const D: usize> Stage<D> for MirrorVelocity {
     }
 
     fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
-        let nf = s.particles.fluid;
-        let (fluid, mirrors) = s.particles.u.split_at_mut(nf);
+        let start = s.walls_start();
+        let (fluid, mirrors) = s.particles.u.split_at_mut(start);
         for ((u, &src), &sign) in mirrors.iter_mut().zip(&s.mirrors.source).zip(&s.mirrors.sign) {
             *u = fluid[src as usize] * sign;
         }
