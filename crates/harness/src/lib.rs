@@ -28,6 +28,7 @@ pub mod progress;
 pub mod provenance;
 pub mod report;
 pub mod results;
+pub mod snapshots;
 pub mod sweep;
 pub mod validate;
 pub mod work_precision;
