@@ -230,7 +230,9 @@ pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
     let summary = crate::validate::summary_of(&results);
     io::write_json(&out.join("summary.json"), &summary)?;
     let records: Vec<Option<&CaseRecord>> = found.iter().map(|f| f.1.as_ref()).collect();
-    let page = html::index_page(&results, &records, &summary, comparison.as_ref());
+    let extras: Vec<html::ExtraPage> =
+        crate::stability::load(out).map(|s| s.index_entry()).into_iter().collect();
+    let page = html::index_page_with(&results, &records, &summary, comparison.as_ref(), &extras);
     io::write_atomic(&out.join("index.html"), page.as_bytes())?;
     let md = markdown::summary(&results, &records, &summary, comparison.as_ref());
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
