@@ -394,7 +394,7 @@ pub fn snapshots(
     panels: &[(String, &crate::snapshots::Snapshot)],
 ) -> Result<String> {
     const PANEL: u32 = 430;
-    const BAR: u32 = 120;
+    const BAR: u32 = 140;
     let all_p: Vec<f64> = panels.iter().flat_map(|(_, s)| s.p.iter().copied()).collect();
     let (mut p0, mut p1) = (quantile(&all_p, 0.01).unwrap_or(0.0), quantile(&all_p, 0.99).unwrap_or(1.0));
     if p1 - p0 <= 1e-12 * p0.abs().max(p1.abs()).max(1e-300) {
@@ -432,7 +432,7 @@ pub fn snapshots(
             .margin_top(40)
             .margin_bottom(38)
             .margin_left(10)
-            .right_y_label_area_size(75)
+            .right_y_label_area_size(95)
             .build_cartesian_2d(0.0..1.0, p0..p1)
             .map_err(boxed)?;
         scale
@@ -440,6 +440,8 @@ pub fn snapshots(
             .disable_mesh()
             .disable_x_axis()
             .y_desc("p [Pa]")
+            .y_label_style(("sans-serif", 12))
+            .axis_desc_style(("sans-serif", 14))
             .y_label_formatter(&|v| format!("{v:.2e}"))
             .draw()
             .map_err(boxed)?;
