@@ -728,7 +728,11 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
                 );
                 let mut row = single_row(base, set, "jitter", config, trial, particles);
                 row.metrics.insert("jitter_fraction".into(), f);
-                row.measured = format!("error {}", pct(row.metrics["err"]));
+                row.measured = if row.status == "ok" {
+                    format!("error {}", pct(row.metrics["err"]))
+                } else {
+                    format!("diverged at t = {} s", bisect::sig3(row.metrics["t_final"]))
+                };
                 results.runs.push(row);
             }
             save(&mut results, &runner, &start)?;
@@ -751,7 +755,12 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
             // The long run's verdict is the energy drift, not the axes' error.
             row.outcome = if row.status == "ok" { "ok".into() } else { row.status.clone() };
             row.metrics.insert("ke_drift".into(), drift);
-            row.measured = format!("KE drift {}", pct(drift));
+            row.measured = if row.status == "ok" {
+                format!("KE drift {}", pct(drift))
+            } else {
+                let t = row.trials.first().map_or(f64::NAN, |t| t.t_final);
+                format!("diverged at t = {} s (KE drift {} up to there)", bisect::sig3(t), pct(drift))
+            };
             row.series = BTreeMap::from([("t".to_string(), t_series), ("e".to_string(), e_series)]);
             results.runs.push(row);
             save(&mut results, &runner, &start)?;
