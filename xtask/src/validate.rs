@@ -16,7 +16,8 @@ pub struct Args {
     /// The extended sweeps (finer spacings, long runs).
     #[arg(long)]
     full: bool,
-    /// Run only this case (repeatable); all of validation/*.json by default.
+    /// Run only this case (repeatable); all of validation/*.json by default. `stability`
+    /// runs the stability envelope (reports/stability/), which the full tier also runs.
     #[arg(long = "case", value_name = "NAME")]
     cases: Vec<String>,
     /// Output directory [default: <workspace>/reports].
@@ -41,9 +42,10 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let root = crate::workspace_root();
     let tier = crate::tier(args.quick, args.full);
+    let (cases, run_cases, run_stability) = meniscus_harness::stability::split_cases(&args.cases, tier);
     let opts = ValidateOptions {
         tier,
-        cases: args.cases,
+        cases,
         out: args.out.unwrap_or_else(|| root.join("reports")),
         validation_dir: root.join("validation"),
         workspace: root.clone(),
@@ -53,7 +55,11 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         baseline: args.baseline,
     };
     let start = Instant::now();
-    let outcome = meniscus_harness::validate(&opts).context("validation could not run")?;
+    let outcome = if run_cases {
+        meniscus_harness::validate(&opts).context("validation could not run")?
+    } else {
+        meniscus_harness::Outcome { results: Vec::new(), executed: 0, reused: 0, comparison: None }
+    };
     for r in &outcome.results {
         let (passed, failed) = r.counts();
         eprintln!("{:<24} {:>3} passed {:>3} failed", r.case, passed, failed);
@@ -67,13 +73,46 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     if let Some(cmp) = &outcome.comparison {
         eprintln!("against baseline {}: {}", cmp.baseline.display(), cmp.tally().describe());
     }
-    eprintln!(
-        "{} runs executed, {} cached, {:.1} s; report: {} (summary: {})",
-        outcome.executed,
-        outcome.reused,
-        start.elapsed().as_secs_f64(),
-        opts.out.join("index.html").display(),
-        opts.out.join("summary.md").display()
-    );
-    Ok(if outcome.pass() { ExitCode::SUCCESS } else { ExitCode::FAILURE })
+    let mut stability_pass = true;
+    if run_stability {
+        use meniscus_harness::stability;
+        let s0 = Instant::now();
+        let res = stability::run(&stability::StabilityOptions {
+            out: opts.out.clone(),
+            validation_dir: opts.validation_dir.clone(),
+            workspace: root.clone(),
+            tier,
+            settings: stability::Settings::standard(),
+            force: opts.force,
+            progress: opts.progress,
+        })
+        .context("the stability envelope could not run")?;
+        let (passed, failed) = res.counts();
+        eprintln!(
+            "{:<24} {:>3} passed {:>3} failed ({} rows, {:.1} s) -> {}",
+            "stability",
+            passed,
+            failed,
+            res.runs.len(),
+            s0.elapsed().as_secs_f64(),
+            opts.out.join("stability/index.html").display()
+        );
+        for c in res.checks.iter().filter(|c| !c.pass) {
+            let value = c.value.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
+            let note = c.note.as_deref().map(|n| format!(" [{n}]")).unwrap_or_default();
+            eprintln!("  FAIL {}: {value}{note}", c.name);
+        }
+        stability_pass = res.pass();
+    }
+    if run_cases {
+        eprintln!(
+            "{} runs executed, {} cached, {:.1} s; report: {} (summary: {})",
+            outcome.executed,
+            outcome.reused,
+            start.elapsed().as_secs_f64(),
+            opts.out.join("index.html").display(),
+            opts.out.join("summary.md").display()
+        );
+    }
+    Ok(if outcome.pass() && stability_pass { ExitCode::SUCCESS } else { ExitCode::FAILURE })
 }

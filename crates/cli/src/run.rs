@@ -75,6 +75,18 @@ pub fn run(
     obs.bar.finish_and_clear();
     write_json_atomic(&out.join("probes.json"), &report.probes)?;
     write_json_atomic(&out.join("summary.json"), &report.summary)?;
+    if !report.snapshots.is_empty() {
+        let dir = out.join("snapshots");
+        writable_dir(&dir)?;
+        for (i, frame) in report.snapshots.iter().enumerate() {
+            let path = dir.join(format!("snapshot_{i:03}.json"));
+            let tmp = path.with_extension("json.tmp");
+            std::fs::write(&tmp, serde_json::to_vec(frame)?)
+                .with_context(|| format!("cannot write `{}`", tmp.display()))?;
+            std::fs::rename(&tmp, &path)
+                .with_context(|| format!("cannot rename `{}` to `{}`", tmp.display(), path.display()))?;
+        }
+    }
     if let Some(e) = obs.error {
         return Err(e);
     }

@@ -167,3 +167,21 @@ fn diverged_run_writes_the_last_good_state() {
     let res = meniscus(&["run", s(&scene), "--out", s(&dir.join("out2"))]);
     fails_with(&res, 3, &["--vtk-every"]);
 }
+
+#[test]
+fn run_writes_the_requested_snapshots() {
+    let dir = scratch("snapshots");
+    let scene = small_scene(&dir, |v| v["output"]["snapshot_times"] = serde_json::json!([0.0, 4e-5]));
+    let out_dir = dir.join("out");
+    let out = meniscus(&["run", s(&scene), "--out", s(&out_dir)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let read = |i: usize| -> serde_json::Value {
+        let path = out_dir.join(format!("snapshots/snapshot_{i:03}.json"));
+        serde_json::from_str(&std::fs::read_to_string(&path).expect("snapshot written")).expect("JSON")
+    };
+    let (first, second) = (read(0), read(1));
+    assert_eq!(first["step"], 0);
+    assert!((second["time"].as_f64().unwrap() - 4e-5).abs() < 1e-15, "{}", second["time"]);
+    assert_eq!(first["x"].as_array().unwrap().len(), second["p"].as_array().unwrap().len());
+    assert!(!out_dir.join("snapshots/snapshot_002.json").exists());
+}

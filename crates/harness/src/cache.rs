@@ -31,6 +31,9 @@ pub struct RunRecord {
     pub summary: meniscus::Summary,
     /// The solver's `probes.json` content (non-finite samples written as `null`).
     pub probes: CachedProbes,
+    /// The particles at the scene's `output.snapshot_times` (2D runs; absent when none).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub snapshots: Vec<crate::snapshots::Snapshot>,
 }
 
 /// `probes.json` content that survives NaN samples (written as `null`, read back as NaN).
@@ -131,6 +134,7 @@ pub(crate) mod tests {
                 series: [("kinetic_energy".to_string(), [("e".to_string(), vec![1.0, f64::NAN])].into())]
                     .into(),
             },
+            snapshots: Vec::new(),
         }
     }
 

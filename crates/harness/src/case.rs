@@ -233,6 +233,22 @@ pub enum Figure {
         /// (run series, reference series) pairs, e.g. `["b_moment", "b_ref"]`.
         pairs: Vec<[String; 2]>,
     },
+    /// Particle positions coloured by pressure at each snapshot time of the runs
+    /// (`output.snapshot_times`), one panel per preset side by side with a shared colour
+    /// bar: `<file>_<i>.svg` for the i-th time. Drawn from `snapshots/<slug>.json`; a preset
+    /// without snapshots (not run in this tier) is left out.
+    Snapshots {
+        /// File stem.
+        file: String,
+        /// Title.
+        #[serde(default)]
+        title: String,
+        /// Presets side by side.
+        presets: Vec<String>,
+        /// Spacing of the runs shown (the finest with snapshots when absent).
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        dx: Option<f64>,
+    },
 }
 
 impl Case {

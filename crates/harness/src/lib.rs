@@ -28,6 +28,8 @@ pub mod progress;
 pub mod provenance;
 pub mod report;
 pub mod results;
+pub mod snapshots;
+pub mod stability;
 pub mod sweep;
 pub mod validate;
 pub mod work_precision;

@@ -119,6 +119,7 @@ pub fn execute(spec: &RunSpec, observer: &mut dyn meniscus::Observer) -> Result<
         scene: spec.scene_json.clone(),
         summary: report.summary,
         probes: CachedProbes::from(report.probes),
+        snapshots: report.snapshots.iter().map(crate::snapshots::Snapshot::from).collect(),
     })
 }
 

@@ -89,6 +89,16 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
         bar.finish_with_message(format!("{executed} run, {} cached", specs.len() - executed));
         outcome.executed += executed;
         outcome.reused += specs.len() - executed;
+        for r in records.iter().filter(|r| !r.snapshots.is_empty()) {
+            let file = crate::snapshots::SnapshotFile {
+                slug: r.slug.clone(),
+                preset: r.preset.clone(),
+                dx: r.dx,
+                status: status(r),
+                frames: r.snapshots.clone(),
+            };
+            crate::snapshots::store(&case_dir, &file)?;
+        }
         let results = assemble(case, opts.tier, &records)?;
         let record = CaseRecord {
             case: case.clone(),

@@ -40,8 +40,9 @@ pub struct Summary {
     pub ppe_iterations_mean: f64,
 }
 
-/// A particle snapshot in initial-id order, for VTK frames and final-state metrics.
-#[derive(Debug, Clone, Default, PartialEq)]
+/// A particle snapshot in initial-id order, for VTK frames, final-state metrics and the
+/// snapshots of `output.snapshot_times`.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct Frame {
     /// Step number.
     pub step: usize,
@@ -86,6 +87,9 @@ pub struct RunReport {
     /// When the run diverged: the particles at the start of the failing step (the last
     /// state that passed every guard), for `frames/last_good.vtu`.
     pub last_good: Option<Frame>,
+    /// The particles at each of `output.snapshot_times` reached (a diverged run has the
+    /// ones before the divergence).
+    pub snapshots: Vec<Frame>,
 }
 
 impl RunReport {
@@ -254,6 +258,15 @@ impl<const D: usize> Simulation<D> {
             domain.wrap(x);
         }
         check_seeds(&particles, &body_start, scene.dx, domain)?;
+        for (i, body) in scene.bodies.iter().enumerate() {
+            if let Some(jitter) = &body.jitter {
+                let end = body_start.get(i + 1).copied().unwrap_or(particles.fluid);
+                lattice::apply_jitter(&mut particles.x[body_start[i]..end], scene.dx, jitter);
+            }
+        }
+        for x in &mut particles.x {
+            domain.wrap(x);
+        }
         let h = scene.h();
         let support = match scene.kernel.kind {
             KernelKind::CubicSpline => Scaled::<CubicSpline, D>::new(h).support,
@@ -356,9 +369,20 @@ impl<const D: usize> Simulation<D> {
         // Requested probe times: steps are shortened to land on them.
         let targets = self.scene.output.probe_times.clone();
         let mut next = targets.iter().take_while(|&&s| s <= 0.0).count();
+        // Requested snapshot times: steps land on them too.
+        let snaps = self.scene.output.snapshot_times.clone();
+        let mut snapshots = Vec::new();
+        let mut next_snap = 0;
+        let due = |next_snap: usize, t: f64| snaps.get(next_snap).is_some_and(|&s| s <= t + 1e-12 * t_end);
+        while due(next_snap, t) {
+            snapshots.push(self.frame(step, t));
+            next_snap += 1;
+        }
         while t < t_end * (1.0 - 1e-12) {
             self.keep_last_good(step, t);
-            let stop = targets.get(next).copied().filter(|&s| s < t_end).unwrap_or(t_end);
+            let probe_stop = targets.get(next).copied().filter(|&s| s < t_end).unwrap_or(t_end);
+            let snap_stop = snaps.get(next_snap).copied().filter(|&s| s < t_end).unwrap_or(t_end);
+            let stop = probe_stop.min(snap_stop);
             let dt = match self.time_step(stop - t) {
                 Ok(dt) => dt,
                 Err(cause) => {
@@ -391,9 +415,14 @@ impl<const D: usize> Simulation<D> {
             let landed = (stop - (t + dt)).abs() <= 1e-12 * t_end;
             t = if landed { stop } else { t + dt };
             let last = t >= t_end * (1.0 - 1e-12);
-            let hit = landed && !last;
+            // A probe time is hit when the step landed on it (not on a snapshot time before it).
+            let hit = landed && !last && probe_stop <= snap_stop;
             if hit {
                 next += 1;
+            }
+            while due(next_snap, t) {
+                snapshots.push(self.frame(step, t));
+                next_snap += 1;
             }
             if step % every == 0 || last || hit {
                 let s0 = Instant::now();
@@ -425,7 +454,7 @@ impl<const D: usize> Simulation<D> {
             ppe_iterations_mean: ppe_iters as f64 / step.max(1) as f64,
         };
         let last_good = error.as_ref().map(|_| self.last_good_frame());
-        RunReport { summary, probes: record, final_frame: self.frame(step, t), error, last_good }
+        RunReport { summary, probes: record, final_frame: self.frame(step, t), error, last_good, snapshots }
     }
 
     /// Δt of the next step, never past `remaining` (the time to the end or to the next

@@ -265,6 +265,25 @@ fn malformed_scene_table() {
         }),
         ("output.probe_every", "at least 1", |v| v["output"]["probe_every"] = json!(0)),
         ("output.vtk_every", "", |v| v["output"]["vtk_every"] = json!(-1)),
+        ("output.snapshot_times[1]", "larger than the time before", |v| {
+            v["output"]["snapshot_times"] = json!([0.004, 0.002])
+        }),
+        ("output.snapshot_times[0]", "not be negative", |v| v["output"]["snapshot_times"] = json!([-0.001])),
+        ("output.snapshot_times[0]", "exceed time.end", |v| v["output"]["snapshot_times"] = json!([0.5])),
+        ("output.snapshot_times", "at most 100", |v| {
+            v["output"]["snapshot_times"] = json!((0..101).map(|i| i as f64 * 1e-5).collect::<Vec<_>>())
+        }),
+        ("output.snapshot_times[0]", "", |v| v["output"]["snapshot_times"] = json!(["soon"])),
+        ("bodies[0].jitter.fraction", "[0, 0.5)", |v| {
+            v["bodies"][0]["jitter"] = json!({"fraction": 0.5, "seed": 1})
+        }),
+        ("bodies[0].jitter.fraction", "[0, 0.5)", |v| {
+            v["bodies"][0]["jitter"] = json!({"fraction": -0.1, "seed": 1})
+        }),
+        ("bodies[0].jitter.seed", "", |v| v["bodies"][0]["jitter"] = json!({"fraction": 0.1, "seed": -3})),
+        ("bodies[0].jitter.amplitude", "unknown field", |v| {
+            v["bodies"][0]["jitter"] = json!({"fraction": 0.1, "seed": 1, "amplitude": 2})
+        }),
         ("name", "empty", |v| v["name"] = json!("  ")),
         ("name", "", |v| v["name"] = json!(42)),
         ("probes[0]", "", |v| v["probes"] = json!([{"vorticity": {}}])),

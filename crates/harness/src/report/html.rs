@@ -178,11 +178,11 @@ fn baseline_section(cmp: &Comparison, case: &CaseComparison) -> Markup {
     }
 }
 
-fn pass_cell(pass: bool) -> Markup {
+pub(crate) fn pass_cell(pass: bool) -> Markup {
     html! { td class=(if pass { "pass" } else { "fail" }) { (if pass { "PASS" } else { "FAIL" }) } }
 }
 
-fn page(title: &str, body: Markup) -> String {
+pub(crate) fn page(title: &str, body: Markup) -> String {
     html! {
         (DOCTYPE)
         html lang="en" {
@@ -404,12 +404,36 @@ fn baseline_cell(case: Option<&CaseComparison>) -> Markup {
     }
 }
 
+/// A page of the report beside the cases (the stability envelope), linked from the index.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ExtraPage {
+    /// Relative link (`stability/index.html`).
+    pub href: String,
+    /// Link text.
+    pub title: String,
+    /// One line about it (tier, rows, checks).
+    pub summary: String,
+    /// Whether its checks passed.
+    pub pass: bool,
+}
+
 /// `reports/index.html`: one row per case; with a comparison, a "vs baseline" column.
 pub fn index_page(
     results: &[CaseResults],
     records: &[Option<&CaseRecord>],
     summary: &Summary,
     comparison: Option<&Comparison>,
+) -> String {
+    index_page_with(results, records, summary, comparison, &[])
+}
+
+/// [`index_page`] with links to the `extras` pages after the table of cases.
+pub fn index_page_with(
+    results: &[CaseResults],
+    records: &[Option<&CaseRecord>],
+    summary: &Summary,
+    comparison: Option<&Comparison>,
+    extras: &[ExtraPage],
 ) -> String {
     let body = html! {
         h1 { "Meniscus validation" }
@@ -440,6 +464,19 @@ pub fn index_page(
                     td { (passed) " / " (passed + failed) }
                     (pass_cell(failed == 0))
                     @if let Some(cmp) = comparison { (baseline_cell(cmp.case(&r.case))) }
+                }
+            }
+        }
+        @if !extras.is_empty() {
+            h2 { "Stress tests" }
+            table {
+                tr { th class="l" { "page" } th class="l" { "what" } th { "result" } }
+                @for e in extras {
+                    tr {
+                        td class="l" { a href=(e.href) { (e.title) } }
+                        td class="l" { (e.summary) }
+                        (pass_cell(e.pass))
+                    }
                 }
             }
         }

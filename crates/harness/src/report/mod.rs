@@ -71,6 +71,9 @@ pub fn render_case(
                 io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
                 figures.push(FigureFile { file: name, caption: title.clone() });
             }
+            Figure::Snapshots { file, title, presets, dx } => {
+                snapshot_figures(case_dir, &runs, file, title, presets, *dx, &mut figures)?;
+            }
         }
     }
     let page = html::case_page(results, record, &figures, comparison);
@@ -94,6 +97,57 @@ fn per_preset(
         let name = format!("{file}_{p}.svg");
         let caption = format!("{title} — preset {p}");
         let svg = draw(&name, &caption, &mine)?;
+        io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
+        figures.push(FigureFile { file: name, caption });
+    }
+    Ok(())
+}
+
+/// Draws the snapshot figures of `presets` (see [`Figure::Snapshots`]): one SVG per
+/// snapshot time, the presets' panels side by side.
+fn snapshot_figures(
+    case_dir: &Path,
+    runs: &[&RunResult],
+    file: &str,
+    title: &str,
+    presets: &[String],
+    dx: Option<f64>,
+    figures: &mut Vec<FigureFile>,
+) -> Result<()> {
+    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs();
+    let with_snapshots: Vec<(&RunResult, crate::snapshots::SnapshotFile)> = runs
+        .iter()
+        .filter(|r| presets.contains(&r.preset) && dx.is_none_or(|d| close(r.dx, d)))
+        .filter_map(|r| crate::snapshots::load(case_dir, &r.slug()).map(|s| (*r, s)))
+        .collect();
+    let Some(finest) = with_snapshots.iter().map(|(r, _)| r.dx).min_by(f64::total_cmp) else {
+        return Ok(());
+    };
+    // Presets in the figure's order, at the chosen spacing.
+    let shown: Vec<&crate::snapshots::SnapshotFile> = presets
+        .iter()
+        .filter_map(|p| with_snapshots.iter().find(|(r, _)| &r.preset == p && close(r.dx, finest)))
+        .map(|(_, s)| s)
+        .collect();
+    let times = shown.iter().map(|s| s.frames.len()).max().unwrap_or(0);
+    for i in 0..times {
+        let panels: Vec<(String, &crate::snapshots::Snapshot)> = shown
+            .iter()
+            .filter_map(|s| {
+                let f = s.frames.get(i)?;
+                let note = if s.status == "ok" { "" } else { " (diverged later)" };
+                Some((format!("{}, t = {:.4} s{note}", s.preset, f.time), f))
+            })
+            .collect();
+        let t = panels.first().map_or(0.0, |p| p.1.time);
+        let name = format!("{file}_{i}.svg");
+        let caption = format!(
+            "{title} — t = {t:.4} s, dx = {}; colour: pressure [Pa], one scale for both panels \
+             (clipped to the 1st–99th percentile)",
+            html::format_dx(finest)
+        );
+        let heading = format!("{title}, dx = {}", html::format_dx(finest));
+        let svg = plots::snapshots(&name, &heading, &panels)?;
         io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
         figures.push(FigureFile { file: name, caption });
     }
@@ -180,7 +234,9 @@ pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
     let summary = crate::validate::summary_of(&results);
     io::write_json(&out.join("summary.json"), &summary)?;
     let records: Vec<Option<&CaseRecord>> = found.iter().map(|f| f.1.as_ref()).collect();
-    let page = html::index_page(&results, &records, &summary, comparison.as_ref());
+    let extras: Vec<html::ExtraPage> =
+        crate::stability::load(out).map(|s| s.index_entry()).into_iter().collect();
+    let page = html::index_page_with(&results, &records, &summary, comparison.as_ref(), &extras);
     io::write_atomic(&out.join("index.html"), page.as_bytes())?;
     let md = markdown::summary(&results, &records, &summary, comparison.as_ref());
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
@@ -292,6 +348,55 @@ mod tests {
         assert!(!summary.pass);
         assert_eq!((summary.passed, summary.failed), (1, 1));
         assert_eq!(summary.cases[0].diverged, 1);
+    }
+
+    #[test]
+    fn snapshot_figures_pair_the_presets_per_time() {
+        let dir = Scratch::new("report-snapshots");
+        let case =
+            Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/rotating_square.json"))
+                .unwrap();
+        let mut results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
+        results.case = "rotating_square".into();
+        results.runs.truncate(2);
+        results.runs[0].preset = "shifting".into();
+        results.runs[1].preset = "no_shifting".into();
+        for r in &mut results.runs {
+            r.dx = 0.02;
+        }
+        for (r, status) in results.runs.iter().zip(["ok", "diverged: at step 9"]) {
+            let frame = |t: f64| crate::snapshots::Snapshot {
+                time: t,
+                step: 1,
+                x: vec![0.0, 0.1],
+                y: vec![0.0, 0.1],
+                p: vec![-1.0, 0.0],
+            };
+            let file = crate::snapshots::SnapshotFile {
+                slug: r.slug(),
+                preset: r.preset.clone(),
+                dx: r.dx,
+                status: status.into(),
+                frames: vec![frame(0.0), frame(0.05)],
+            };
+            crate::snapshots::store(dir.path(), &file).unwrap();
+        }
+        let record = CaseRecord { case, provenance: Provenance::default(), scene_hashes: Default::default() };
+        let figs = render_case(dir.path(), &results, Some(&record), None).unwrap();
+        let snaps: Vec<&FigureFile> = figs.iter().filter(|f| f.file.starts_with("snapshots")).collect();
+        // Two times of the mu = 1000 pair; the inviscid pair has no snapshots: no figure.
+        assert_eq!(
+            snaps.iter().map(|f| f.file.as_str()).collect::<Vec<_>>(),
+            ["snapshots_0.svg", "snapshots_1.svg"]
+        );
+        assert!(snaps[1].caption.contains("t = 0.0500 s"), "{}", snaps[1].caption);
+        let svg = std::fs::read_to_string(dir.path().join("snapshots_1.svg")).unwrap();
+        assert!(
+            svg.contains("shifting, t = 0.0500 s")
+                && svg.contains("no_shifting, t = 0.0500 s (diverged later)")
+        );
+        let page = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
+        assert!(page.contains("snapshots_1.svg"));
     }
 
     #[test]

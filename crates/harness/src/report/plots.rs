@@ -58,9 +58,17 @@ fn finite_points(x: &[f64], y: &[f64]) -> Vec<(f64, f64)> {
 fn svg(
     draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> std::result::Result<(), Box<dyn std::fmt::Debug>>,
 ) -> std::result::Result<String, Box<dyn std::fmt::Debug>> {
+    svg_sized(SIZE, draw)
+}
+
+/// Like [`svg`] with another size in pixels.
+fn svg_sized(
+    size: (u32, u32),
+    draw: impl FnOnce(&DrawingArea<SVGBackend, Shift>) -> std::result::Result<(), Box<dyn std::fmt::Debug>>,
+) -> std::result::Result<String, Box<dyn std::fmt::Debug>> {
     let mut out = String::new();
     {
-        let root = SVGBackend::with_string(&mut out, SIZE).into_drawing_area();
+        let root = SVGBackend::with_string(&mut out, size).into_drawing_area();
         root.fill(&WHITE).map_err(boxed)?;
         draw(&root)?;
         root.present().map_err(boxed)?;
@@ -353,4 +361,145 @@ pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Resul
         Ok(())
     })
     .map_err(plot_err(file))
+}
+
+/// Control points of the viridis colour map (matplotlib), evenly spaced on [0, 1].
+const VIRIDIS: [(u8, u8, u8); 9] = [
+    (68, 1, 84),
+    (71, 44, 122),
+    (59, 81, 139),
+    (44, 113, 142),
+    (33, 144, 141),
+    (39, 173, 129),
+    (92, 200, 99),
+    (170, 220, 50),
+    (253, 231, 37),
+];
+
+/// Viridis at `s` in [0, 1] (clamped), linear between the control points.
+pub(crate) fn viridis(s: f64) -> RGBColor {
+    let s = if s.is_finite() { s.clamp(0.0, 1.0) } else { 0.0 };
+    let x = s * (VIRIDIS.len() - 1) as f64;
+    let i = (x.floor() as usize).min(VIRIDIS.len() - 2);
+    let f = x - i as f64;
+    let (a, b) = (VIRIDIS[i], VIRIDIS[i + 1]);
+    let mix = |p: u8, q: u8| (p as f64 + f * (q as f64 - p as f64)).round() as u8;
+    RGBColor(mix(a.0, b.0), mix(a.1, b.1), mix(a.2, b.2))
+}
+
+/// The `q`-quantile (0–1) of the finite values (nearest rank); `None` when there are none.
+fn quantile(values: &[f64], q: f64) -> Option<f64> {
+    let mut v: Vec<f64> = values.iter().copied().filter(|x| x.is_finite()).collect();
+    if v.is_empty() {
+        return None;
+    }
+    v.sort_by(f64::total_cmp);
+    Some(v[((v.len() - 1) as f64 * q).round() as usize])
+}
+
+/// Particle scatter plots coloured by pressure: one square panel per `(label, snapshot)`
+/// side by side, the same axes and colour scale for all (the 1st–99th percentile of the
+/// pressures, so that a few outliers do not wash out the rest), and a colour bar.
+pub fn snapshots(
+    file: &str,
+    title: &str,
+    panels: &[(String, &crate::snapshots::Snapshot)],
+) -> Result<String> {
+    const PANEL: u32 = 430;
+    const BAR: u32 = 140;
+    let all_p: Vec<f64> = panels.iter().flat_map(|(_, s)| s.p.iter().copied()).collect();
+    let (mut p0, mut p1) = (quantile(&all_p, 0.01).unwrap_or(0.0), quantile(&all_p, 0.99).unwrap_or(1.0));
+    if p1 - p0 <= 1e-12 * p0.abs().max(p1.abs()).max(1e-300) {
+        let pad = p0.abs().max(1.0) * 0.5;
+        (p0, p1) = (p0 - pad, p1 + pad);
+    }
+    let (x0, x1) = range(panels.iter().flat_map(|(_, s)| s.x.iter().copied()), 0.04);
+    let (y0, y1) = range(panels.iter().flat_map(|(_, s)| s.y.iter().copied()), 0.04);
+    // Equal scales on both axes: a square panel shows the larger extent on both.
+    let half = 0.5 * (x1 - x0).max(y1 - y0);
+    let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+    let (xr, yr) = ((cx - half)..(cx + half), (cy - half)..(cy + half));
+    let n = panels.len().max(1) as u32;
+    svg_sized((PANEL * n + BAR, PANEL + 40), |root| {
+        let root = root.titled(title, ("sans-serif", 14)).map_err(boxed)?;
+        let (left, bar) = root.split_horizontally(PANEL * n);
+        for (area, (label, snap)) in left.split_evenly((1, n as usize)).iter().zip(panels) {
+            let mut chart = ChartBuilder::on(area)
+                .caption(label, ("sans-serif", 15))
+                .margin(8)
+                .x_label_area_size(30)
+                .y_label_area_size(45)
+                .build_cartesian_2d(xr.clone(), yr.clone())
+                .map_err(boxed)?;
+            chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(boxed)?;
+            let pts =
+                snap.x.iter().zip(&snap.y).zip(&snap.p).filter(|((x, y), _)| x.is_finite() && y.is_finite());
+            chart
+                .draw_series(
+                    pts.map(|((&x, &y), &p)| Circle::new((x, y), 2, viridis((p - p0) / (p1 - p0)).filled())),
+                )
+                .map_err(boxed)?;
+        }
+        let mut scale = ChartBuilder::on(&bar)
+            .margin_top(40)
+            .margin_bottom(38)
+            .margin_left(10)
+            .right_y_label_area_size(95)
+            .build_cartesian_2d(0.0..1.0, p0..p1)
+            .map_err(boxed)?;
+        scale
+            .configure_mesh()
+            .disable_mesh()
+            .disable_x_axis()
+            .y_desc("p [Pa]")
+            .y_label_style(("sans-serif", 12))
+            .axis_desc_style(("sans-serif", 14))
+            .y_label_formatter(&|v| format!("{v:.2e}"))
+            .draw()
+            .map_err(boxed)?;
+        const SLICES: usize = 64;
+        scale
+            .draw_series((0..SLICES).map(|k| {
+                let (a, b) = (k as f64 / SLICES as f64, (k + 1) as f64 / SLICES as f64);
+                let (lo, hi) = (p0 + a * (p1 - p0), p0 + b * (p1 - p0));
+                Rectangle::new([(0.0, lo), (1.0, hi)], viridis(0.5 * (a + b)).filled())
+            }))
+            .map_err(boxed)?;
+        Ok(())
+    })
+    .map_err(plot_err(file))
+}
+
+#[cfg(test)]
+mod snapshot_tests {
+    use super::*;
+    use crate::snapshots::Snapshot;
+
+    #[test]
+    fn viridis_ends_and_clamps() {
+        assert_eq!(viridis(0.0), RGBColor(68, 1, 84));
+        assert_eq!(viridis(1.0), RGBColor(253, 231, 37));
+        assert_eq!(viridis(2.0), viridis(1.0));
+        assert_eq!(viridis(f64::NAN), viridis(0.0));
+        assert_eq!(viridis(0.5), RGBColor(33, 144, 141));
+    }
+
+    #[test]
+    fn scatter_has_a_point_per_particle_and_a_colour_bar() {
+        let snap = |shift: f64| Snapshot {
+            time: 0.01,
+            step: 100,
+            x: (0..50).map(|i| (i % 10) as f64 * 0.1 + shift).collect(),
+            y: (0..50).map(|i| (i / 10) as f64 * 0.1).collect(),
+            p: (0..50).map(|i| -1e5 * i as f64).collect(),
+        };
+        let (a, b) = (snap(0.0), snap(0.01));
+        let svg =
+            snapshots("s.svg", "Snapshots", &[("shifting".into(), &a), ("no_shifting".into(), &b)]).unwrap();
+        assert!(svg.starts_with("<svg") && svg.contains("no_shifting") && svg.contains("p [Pa]"));
+        assert!(svg.matches("<circle").count() >= 100, "one marker per particle");
+        // A uniform field (t = 0: p = 0 everywhere) still draws.
+        let flat = Snapshot { p: vec![0.0; 50], ..snap(0.0) };
+        assert!(snapshots("f.svg", "t = 0", &[("shifting".into(), &flat)]).is_ok());
+    }
 }

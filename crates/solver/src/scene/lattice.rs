@@ -4,8 +4,9 @@
 //! is symmetric about the centre; a disc keeps the points with `|x − c| ≤ R`
 //! (R = 1, Δx = 0.04 gives the 1976 particles of Qiu 2013 §3.1).
 
-use super::schema::{Body, InitialPressure, InitialVelocity, Shape};
+use super::schema::{Body, InitialPressure, InitialVelocity, Jitter, Shape};
 use nalgebra::{SMatrix, SVector};
+use rand::{Rng, SeedableRng};
 
 /// Relative tolerance on shape membership, so lattice points exactly on the boundary count.
 const EDGE_TOL: f64 = 1e-9;
@@ -84,6 +85,23 @@ pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector
         .collect()
 }
 
+/// Displaces every point by a vector uniform in the ball of radius `jitter.fraction · dx`
+/// (rejection sampling in the cube), drawn in order from ChaCha8 seeded with `jitter.seed`:
+/// deterministic for a seed, independent of threads and platform.
+pub fn apply_jitter<const D: usize>(points: &mut [SVector<f64, D>], dx: f64, jitter: &Jitter) {
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(jitter.seed);
+    let radius = jitter.fraction * dx;
+    for x in points {
+        let v = loop {
+            let v = SVector::<f64, D>::from_fn(|_, _| rng.random_range(-1.0..=1.0));
+            if v.norm_squared() <= 1.0 {
+                break v;
+            }
+        };
+        *x += radius * v;
+    }
+}
+
 /// Calls `f` for every integer index `i` with `lo[k] <= i[k] <= hi[k]`, last axis fastest.
 fn for_each_index<const D: usize>(lo: [i64; D], hi: [i64; D], mut f: impl FnMut(&[i64; D])) {
     if (0..D).any(|k| hi[k] < lo[k]) {
@@ -139,6 +157,33 @@ mod tests {
         // 1e6 × 1 lattice points: iterating the square of the long side would take hours.
         let s = Shape::Rectangle { min: vec![0.0, 0.0], max: vec![1e4, 0.01] };
         assert_eq!(lattice_points::<2>(&s, 0.01).len(), 1_000_000);
+    }
+
+    #[test]
+    fn jitter_is_seeded_bounded_and_disorders() {
+        let s = Shape::Rectangle { min: vec![0.0, 0.0], max: vec![1.0, 1.0] };
+        let dx = 0.05;
+        let lattice = lattice_points::<2>(&s, dx);
+        let jittered = |fraction: f64, seed: u64| {
+            let mut pts = lattice.clone();
+            apply_jitter(&mut pts, dx, &Jitter { fraction, seed });
+            pts
+        };
+        let a = jittered(0.3, 7);
+        assert_eq!(a, jittered(0.3, 7), "same seed, same particles");
+        assert_ne!(a, jittered(0.3, 8), "another seed, other particles");
+        let moved: Vec<f64> = a.iter().zip(&lattice).map(|(p, q)| (p - q).norm() / dx).collect();
+        let max = moved.iter().copied().fold(0.0, f64::max);
+        let mean = moved.iter().sum::<f64>() / moved.len() as f64;
+        assert!(max <= 0.3 + 1e-12, "bounded by 0.3 dx: {max}");
+        // Uniform in the disc: the mean distance is 2/3 of the radius.
+        assert!((mean - 0.2).abs() < 0.02, "mean displacement {mean} dx");
+        assert!(max > 0.29, "the whole disc is sampled: {max}");
+        assert_eq!(jittered(0.0, 7), lattice, "fraction 0 leaves the lattice");
+        let mut b = lattice_points::<3>(&Shape::Sphere { center: vec![0.0; 3], radius: 0.2 }, dx);
+        let before = b.clone();
+        apply_jitter(&mut b, dx, &Jitter { fraction: 0.1, seed: 1 });
+        assert!(b.iter().zip(&before).all(|(p, q)| (p - q).norm() <= 0.1 * dx + 1e-15));
     }
 
     #[test]

@@ -87,6 +87,24 @@ pub struct Body {
     /// Initial pressure field (zero if absent).
     #[serde(default)]
     pub pressure: InitialPressure,
+    /// Random displacement of the body's lattice (none if absent): a stress test of how a
+    /// scheme copes with a disordered start.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub jitter: Option<Jitter>,
+}
+
+/// A seeded random displacement of every particle of a body, uniform in the disc (ball in
+/// 3D) of radius `fraction · Δx`, drawn from ChaCha8 seeded with `seed` in particle order:
+/// the same scene gives the same particles on any machine and thread count. Applied after
+/// the overlap check of the lattice (a jittered pair may come closer than Δx/2); the
+/// initial velocity and pressure are those of the lattice point.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Jitter {
+    /// Largest displacement over Δx, in `[0, 0.5)` (0.1 = 10 % of Δx).
+    pub fraction: f64,
+    /// Seed of the random stream.
+    pub seed: u64,
 }
 
 /// What the particles of a body are.
@@ -485,11 +503,21 @@ pub struct OutputSpec {
     /// exactly (increasing, within the end time).
     #[serde(default)]
     pub probe_times: Vec<f64>,
+    /// Times \[s\] at which every particle's position, velocity and pressure is recorded
+    /// ([`crate::RunReport::snapshots`]; `meniscus run` writes `DIR/snapshots/`); steps are
+    /// shortened to land on them exactly (increasing, from 0 to the end time, at most 100).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub snapshot_times: Vec<f64>,
 }
 
 impl Default for OutputSpec {
     fn default() -> Self {
-        Self { probe_every: default_probe_every(), vtk_every: 0, probe_times: Vec::new() }
+        Self {
+            probe_every: default_probe_every(),
+            vtk_every: 0,
+            probe_times: Vec::new(),
+            snapshot_times: Vec::new(),
+        }
     }
 }
 

@@ -5,8 +5,8 @@
 use super::schema::*;
 use crate::error::SceneError;
 
-/// Checks `boundaries.walls`, `boundaries.inflow`/`outflow`, the `velocity_profile` probes
-/// and `output.probe_times`.
+/// Checks `boundaries.walls`, `boundaries.inflow`/`outflow`, the `velocity_profile`
+/// probes, `output.probe_times`, `output.snapshot_times` and the bodies' `jitter`.
 pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
     let d = scene.dimension;
     open_boundaries(scene)?;
@@ -54,6 +54,39 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
             return Err(SceneError::new(f, t, "must not exceed time.end"));
         }
         last = t;
+    }
+    if scene.output.snapshot_times.len() > MAX_SNAPSHOTS {
+        return Err(SceneError::new(
+            "output.snapshot_times",
+            format!("{} times", scene.output.snapshot_times.len()),
+            format!("must hold at most {MAX_SNAPSHOTS} times (each keeps a copy of every particle)"),
+        ));
+    }
+    for (i, &t) in scene.output.snapshot_times.iter().enumerate() {
+        let f = format!("output.snapshot_times[{i}]");
+        finite(&f, t)?;
+        if t < 0.0 {
+            return Err(SceneError::new(f, t, "must not be negative"));
+        }
+        if i > 0 && t <= scene.output.snapshot_times[i - 1] {
+            return Err(SceneError::new(f, t, "must be larger than the time before it"));
+        }
+        if t > scene.time.end {
+            return Err(SceneError::new(f, t, "must not exceed time.end"));
+        }
+    }
+    for (i, body) in scene.bodies.iter().enumerate() {
+        if let Some(j) = &body.jitter {
+            let f = format!("bodies[{i}].jitter.fraction");
+            finite(&f, j.fraction)?;
+            if !(0.0..0.5).contains(&j.fraction) {
+                return Err(SceneError::new(
+                    f,
+                    j.fraction,
+                    "must be in [0, 0.5) (a fraction of dx; at 0.5 two neighbours could meet)",
+                ));
+            }
+        }
     }
     Ok(())
 }
@@ -125,6 +158,9 @@ fn open_boundaries(scene: &Scene) -> Result<(), SceneError> {
     }
     Ok(())
 }
+
+/// Most snapshot times a scene may ask for.
+const MAX_SNAPSHOTS: usize = 100;
 
 fn finite(field: &str, v: f64) -> Result<(), SceneError> {
     if v.is_finite() { Ok(()) } else { Err(SceneError::new(field, v, "must be finite")) }
