@@ -21,6 +21,7 @@ pub mod scene;
 pub mod stage;
 pub mod stages;
 pub mod state;
+pub mod two_level;
 
 pub use error::{Cause, SceneError, SolverError};
 pub use probes::ProbeRecord;

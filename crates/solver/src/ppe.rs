@@ -14,7 +14,8 @@
 //! with `Par::Seq`, so the result does not depend on the thread count.
 
 use crate::error::Cause;
-use crate::scene::{PpeOptions, PpeSolver};
+use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
+use crate::two_level::TwoLevel;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::mat::{MatMut, MatRef};
 use faer::matrix_free::bicgstab::{BicgParams, bicgstab, bicgstab_scratch};
@@ -187,8 +188,8 @@ impl PpeSolve {
             return Ok(PpeInfo::default());
         }
         let info = match self.opts.solver {
-            PpeSolver::Cg => self.krylov(a, true)?,
-            PpeSolver::Bicgstab => self.krylov(a, false)?,
+            PpeSolver::Cg => self.krylov(a, true, singular)?,
+            PpeSolver::Bicgstab => self.krylov(a, false, singular)?,
             PpeSolver::Direct => self.direct(a, singular)?,
         };
         let mean_x = if singular { (0..n).map(|i| self.x[(i, 0)]).sum::<f64>() / n as f64 } else { 0.0 };
@@ -210,8 +211,23 @@ impl PpeSolve {
         MemStack::new(&mut self.buf.as_mut().expect("allocated above").1)
     }
 
-    fn krylov(&mut self, a: &PpeMatrix, cg: bool) -> Result<PpeInfo, Cause> {
-        let m = Jacobi(&a.inv_diag);
+    fn krylov(&mut self, a: &PpeMatrix, cg: bool, singular: bool) -> Result<PpeInfo, Cause> {
+        let two_level = match self.opts.preconditioner {
+            Preconditioner::TwoLevel if !singular => TwoLevel::new(a),
+            _ => None,
+        };
+        match two_level {
+            Some(m) => self.krylov_with(a, &m, cg),
+            None => self.krylov_with(a, Jacobi(&a.inv_diag), cg),
+        }
+    }
+
+    fn krylov_with<M: Precond<f64> + Copy>(
+        &mut self,
+        a: &PpeMatrix,
+        m: M,
+        cg: bool,
+    ) -> Result<PpeInfo, Cause> {
         let (tol, max_iters) = (self.opts.tolerance, self.opts.max_iterations);
         let name = self.name();
         let mut x = std::mem::replace(&mut self.x, Mat::zeros(0, 1));
@@ -296,8 +312,13 @@ mod tests {
 
     /// 5-point Laplacian on an m×m grid with Dirichlet boundary, as a PpeMatrix.
     fn grid(m: usize) -> PpeMatrix {
+        strip(m, m)
+    }
+
+    /// 5-point Laplacian on an `rows`×`m` grid with Dirichlet boundary.
+    fn strip(rows: usize, m: usize) -> PpeMatrix {
         let mut a = PpeMatrix { row_ptr: vec![0], ..Default::default() };
-        for i in 0..m {
+        for i in 0..rows {
             for j in 0..m {
                 let k = i * m + j;
                 let mut push = |c: usize, v: f64| a.entries.push((c as u32, v));
@@ -311,7 +332,7 @@ mod tests {
                 if j + 1 < m {
                     push(k + 1, -1.0);
                 }
-                if i + 1 < m {
+                if i + 1 < rows {
                     push(k + m, -1.0);
                 }
                 a.row_ptr.push(a.entries.len());
@@ -319,6 +340,29 @@ mod tests {
             }
         }
         a
+    }
+
+    /// On a long strip (400 × 8, like a channel) the two-level preconditioner gives the
+    /// Jacobi solution in a fraction of the iterations.
+    #[test]
+    fn two_level_preconditioner_cuts_the_iterations_of_a_long_strip() {
+        let a = strip(400, 8);
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
+        let mut solve = |preconditioner, solver| {
+            let opts = PpeOptions { solver, tolerance: 1e-10, max_iterations: 20_000, preconditioner };
+            let mut p = vec![0.0; n];
+            let info = PpeSolve::new(opts).solve(&a, &b, &mut p, false).expect("converges");
+            (p, info.iterations)
+        };
+        for solver in [PpeSolver::Cg, PpeSolver::Bicgstab] {
+            let (pj, jacobi) = solve(Preconditioner::Jacobi, solver);
+            let (pt, two) = solve(Preconditioner::TwoLevel, solver);
+            let err = pj.iter().zip(&pt).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            let scale = pj.iter().map(|x| x.abs()).fold(0.0, f64::max);
+            assert!(err < 1e-7 * scale, "{solver:?}: {err} vs {scale}");
+            assert!(2 * two < jacobi, "{solver:?}: two-level {two} iterations, Jacobi {jacobi}");
+        }
     }
 
     #[test]
@@ -329,7 +373,12 @@ mod tests {
         let mut b = vec![0.0; n];
         a.mul(&x_true, &mut b);
         for solver in [PpeSolver::Cg, PpeSolver::Bicgstab, PpeSolver::Direct] {
-            let mut s = PpeSolve::new(PpeOptions { solver, tolerance: 1e-10, max_iterations: 1000 });
+            let mut s = PpeSolve::new(PpeOptions {
+                solver,
+                tolerance: 1e-10,
+                max_iterations: 1000,
+                preconditioner: Preconditioner::Jacobi,
+            });
             let mut p = vec![0.0; n];
             let info = s.solve(&a, &b, &mut p, false).unwrap();
             let err = p.iter().zip(&x_true).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
@@ -356,7 +405,12 @@ mod tests {
     fn non_convergence_is_a_typed_error() {
         let a = grid(30);
         let b = vec![1.0; a.n()];
-        let mut s = PpeSolve::new(PpeOptions { solver: PpeSolver::Cg, tolerance: 1e-12, max_iterations: 3 });
+        let mut s = PpeSolve::new(PpeOptions {
+            solver: PpeSolver::Cg,
+            tolerance: 1e-12,
+            max_iterations: 3,
+            preconditioner: Preconditioner::Jacobi,
+        });
         let mut p = vec![0.0; a.n()];
         assert!(matches!(s.solve(&a, &b, &mut p, false), Err(Cause::PpeNoConvergence { .. })));
     }
@@ -375,7 +429,12 @@ mod tests {
         }
         let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).sin() + 0.7).collect();
         for solver in [PpeSolver::Cg, PpeSolver::Bicgstab, PpeSolver::Direct] {
-            let mut s = PpeSolve::new(PpeOptions { solver, tolerance: 1e-10, max_iterations: 2000 });
+            let mut s = PpeSolve::new(PpeOptions {
+                solver,
+                tolerance: 1e-10,
+                max_iterations: 2000,
+                preconditioner: Preconditioner::Jacobi,
+            });
             let mut p = vec![0.0; n];
             let info = s.solve(&a, &b, &mut p, true).unwrap();
             assert!(info.residual < 1e-8, "{solver:?} {info:?}");

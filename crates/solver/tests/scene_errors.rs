@@ -114,6 +114,9 @@ fn malformed_scene_table() {
         ("kernel.h_over_dx", "at most 4", |v| v["kernel"]["h_over_dx"] = json!(10)),
         ("kernel.h_over_dx", "", |v| v["kernel"]["h_over_dx"] = json!(true)),
         ("scheme.isph.ppe.tolerance", "positive", |v| v["scheme"]["isph"]["ppe"]["tolerance"] = json!(0)),
+        ("scheme.isph.ppe.preconditioner", "", |v| {
+            v["scheme"]["isph"]["ppe"]["preconditioner"] = json!("ilu")
+        }),
         ("scheme.isph.density_relaxation", "[0, 1]", |v| {
             v["scheme"]["isph"]["density_relaxation"] = json!(1.5)
         }),

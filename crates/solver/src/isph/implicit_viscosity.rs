@@ -14,7 +14,7 @@
 
 use crate::error::Cause;
 use crate::ppe::{PpeMatrix, PpeSolve};
-use crate::scene::{PpeOptions, PpeSolver};
+use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
 use crate::stage::{Stage, StepContext, par_rows_mut};
 use crate::state::State;
 use rayon::prelude::*;
@@ -35,7 +35,12 @@ pub struct ImplicitViscosity {
 impl ImplicitViscosity {
     /// A stage for kinematic viscosity `nu` = μ/ρ \[m²/s\].
     pub fn new(nu: f64) -> Self {
-        let opts = PpeOptions { solver: PpeSolver::Cg, tolerance: TOLERANCE, max_iterations: 2000 };
+        let opts = PpeOptions {
+            solver: PpeSolver::Cg,
+            tolerance: TOLERANCE,
+            max_iterations: 2000,
+            preconditioner: Preconditioner::Jacobi,
+        };
         Self { nu, matrix: PpeMatrix::default(), solver: PpeSolve::new(opts), rhs: Vec::new(), x: Vec::new() }
     }
 }

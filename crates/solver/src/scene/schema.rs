@@ -358,6 +358,22 @@ pub struct PpeOptions {
     pub tolerance: f64,
     /// Iteration cap of the Krylov solvers.
     pub max_iterations: usize,
+    /// Preconditioner of the Krylov solvers (default Jacobi).
+    #[serde(default)]
+    pub preconditioner: Preconditioner,
+}
+
+/// Preconditioners of the Krylov PPE solvers.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Preconditioner {
+    /// `diag(A)⁻¹`.
+    #[default]
+    Jacobi,
+    /// Jacobi plus a coarse-space correction by aggregation (`two_level.rs`): for long
+    /// domains, whose smooth pressure modes Jacobi leaves to the Krylov iterations. A
+    /// system with no Dirichlet row keeps Jacobi.
+    TwoLevel,
 }
 
 /// Linear solvers for the PPE.
