@@ -320,7 +320,7 @@ mod tests {
         assert_eq!(case.spacings(Tier::Quick), [0.04, 0.02]);
         assert_eq!(case.spacings(Tier::Full).len(), 4);
         assert_eq!(case.primary_preset(), "paper");
-        assert_eq!(case.presets(Tier::Quick).count(), 2);
+        assert_eq!(case.presets(Tier::Quick).count(), 4);
         assert!(case.checks.len() >= 8);
         assert!(!case.errata.is_empty());
     }

@@ -129,7 +129,33 @@ fn malformed_scene_table() {
         ("scheme.isph.shifting.fickian", "missing field", |v| {
             v["scheme"]["isph"]["shifting"] = json!({"xu": {}, "fickian": {}})
         }),
-        ("scheme", "", |v| v["scheme"] = json!({"wcsph": {}})),
+        // `sound_speed` is required.
+        ("scheme.wcsph", "sound_speed", |v| v["scheme"] = json!({"wcsph": {}})),
+        ("scheme", "", |v| v["scheme"] = json!({"mps": {}})),
+        ("scheme.wcsph.sound_speed", "positive", |v| v["scheme"] = json!({"wcsph": {"sound_speed": -10.0}})),
+        ("scheme.wcsph.sound_speed", "positive", |v| v["scheme"] = json!({"wcsph": {"sound_speed": 0.0}})),
+        ("scheme.wcsph.gamma", "1..=10", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "gamma": 0.5}})
+        }),
+        ("scheme.wcsph.artificial_viscosity.alpha", "negative", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "artificial_viscosity": {"alpha": -0.1}}})
+        }),
+        ("scheme.wcsph.artificial_viscosity.beta", "negative", |v| {
+            v["scheme"] =
+                json!({"wcsph": {"sound_speed": 10.0, "artificial_viscosity": {"alpha": 0.1, "beta": -2.0}}})
+        }),
+        ("scheme.wcsph.artificial_viscosity.alpha", "at most 10", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "artificial_viscosity": {"alpha": 50.0}}})
+        }),
+        ("scheme.wcsph.density_diffusion", "negative", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "density_diffusion": -0.1}})
+        }),
+        ("scheme.wcsph.density_diffusion", "at most 1", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "density_diffusion": 3.0}})
+        }),
+        ("scheme.wcsph.c0", "unknown field", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "c0": 1.0}})
+        }),
         // Time.
         ("time.end", "positive", |v| v["time"]["end"] = json!(0)),
         ("time.end", "positive", |v| v["time"]["end"] = json!(-0.008)),

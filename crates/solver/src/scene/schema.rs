@@ -243,6 +243,59 @@ pub struct PeriodicAxis {
 pub enum Scheme {
     /// Projection ISPH (Qiu 2013 §2.2–2.6; Cummins & Rudman 1999; Shao & Lo 2003).
     Isph(IsphOptions),
+    /// Weakly compressible SPH (Xu 2016 with the standard forms of CASES.md erratum 6):
+    /// continuity equation, Tait equation of state, kick-drift-kick integration.
+    Wcsph(WcsphOptions),
+}
+
+impl Scheme {
+    /// The scheme's key in the scene file (`isph`, `wcsph`).
+    pub fn key(&self) -> &'static str {
+        match self {
+            Scheme::Isph(_) => "isph",
+            Scheme::Wcsph(_) => "wcsph",
+        }
+    }
+}
+
+/// Options of the weakly compressible scheme (see [`crate::wcsph`]).
+///
+/// The reference density ρ₀ is `fluid.density`; every particle has the mass
+/// `m = ρ₀ Δx^D`. Pressure follows the Tait equation `p = B ((ρ/ρ₀)^γ − 1)`,
+/// `B = ρ₀ c₀² / γ` (Monaghan 1994, J. Comput. Phys. 110:399, eq. 3.3; Batchelor 1967).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WcsphOptions {
+    /// Artificial speed of sound c₀ \[m/s\] (about 10 × the largest flow speed keeps
+    /// density variations near 1 %).
+    pub sound_speed: f64,
+    /// Exponent γ of the Tait equation (7 for water, the default).
+    #[serde(default = "default_gamma")]
+    pub gamma: f64,
+    /// Monaghan artificial viscosity (none if absent).
+    #[serde(default)]
+    pub artificial_viscosity: Option<ArtificialViscosity>,
+    /// Molteni–Colagrossi density diffusion coefficient δ (none if absent; 0.1 is usual).
+    #[serde(default)]
+    pub density_diffusion: Option<f64>,
+}
+
+fn default_gamma() -> f64 {
+    7.0
+}
+
+/// Monaghan 1992 artificial viscosity (Annu. Rev. Astron. Astrophys. 30:543, eq. 4.1):
+/// `Π_ab = (−α c₀ μ_ab + β μ_ab²) / ρ̄_ab` for approaching pairs (`u_ab·r_ab < 0`),
+/// `μ_ab = h u_ab·r_ab / (r² + 0.01 h²)`, else 0.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArtificialViscosity {
+    /// α (linear, shear and bulk viscosity; Xu 2016 uses 1 for impacts, 0.01–0.1 is usual
+    /// without impacts).
+    pub alpha: f64,
+    /// β (quadratic, against interpenetration at shocks; Xu 2016 uses 2 for impacts).
+    #[serde(default)]
+    pub beta: f64,
 }
 
 /// Options of the projection ISPH scheme.
