@@ -101,6 +101,10 @@ impl RunReport {
 /// 1992, Annu. Rev. Astron. Astrophys. 30:543, §10).
 const WCSPH_FORCE_LIMIT: f64 = 0.25;
 
+/// Coefficient of the capillary time-step limit `Δt ≤ 0.25 √(ρ h³/(2π σ))` (Brackbill,
+/// Kothe & Zemach 1992 eq. 63; Morris 2000), applied to both schemes when σ > 0.
+const CAPILLARY_LIMIT: f64 = 0.25;
+
 /// A simulation of dimension D, built from a scene.
 #[derive(Debug)]
 pub struct Simulation<const D: usize> {
@@ -447,6 +451,14 @@ impl<const D: usize> Simulation<D> {
                             dt = dt.min(WCSPH_FORCE_LIMIT * (h / a).sqrt());
                         }
                     }
+                }
+                let sigma = self.scene.fluid.surface_tension;
+                if sigma > 0.0 {
+                    // Capillary waves (Brackbill, Kothe & Zemach 1992 eq. 63; Morris 2000).
+                    dt = dt.min(
+                        CAPILLARY_LIMIT
+                            * (self.state.density * h * h * h / (2.0 * std::f64::consts::PI * sigma)).sqrt(),
+                    );
                 }
                 let floor = 1e-9 * self.scene.time.end;
                 if dt < floor {

@@ -110,6 +110,13 @@ fn malformed_scene_table() {
         ("fluid.density", "", |v| v["fluid"]["density"] = json!([1000.0])),
         ("fluid.viscosity", "negative", |v| v["fluid"]["viscosity"] = json!(-1.0)),
         ("fluid.surface_tension", "negative", |v| v["fluid"]["surface_tension"] = json!(-0.07)),
+        ("fluid.surface_tension_model", "", |v| v["fluid"]["surface_tension_model"] = json!("marangoni")),
+        ("fluid.surface_tension_threshold", "positive", |v| {
+            v["fluid"]["surface_tension_threshold"] = json!(-0.01)
+        }),
+        ("fluid.surface_tension_threshold", "below 1", |v| {
+            v["fluid"]["surface_tension_threshold"] = json!(2.0)
+        }),
         ("kernel.h_over_dx", "positive", |v| v["kernel"]["h_over_dx"] = json!(0)),
         ("kernel.h_over_dx", "at most 4", |v| v["kernel"]["h_over_dx"] = json!(10)),
         ("kernel.h_over_dx", "", |v| v["kernel"]["h_over_dx"] = json!(true)),

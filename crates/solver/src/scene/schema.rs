@@ -71,6 +71,33 @@ pub struct Fluid {
     /// Surface tension coefficient σ \[N/m\]; 0 (default) builds no surface-tension stage.
     #[serde(default)]
     pub surface_tension: f64,
+    /// Discretisation of the surface tension (used when σ > 0).
+    #[serde(default)]
+    pub surface_tension_model: SurfaceTensionModel,
+    /// Threshold on the colour gradient, in units of 1/h: normals with
+    /// `|∇c| ≤ surface_tension_threshold / h` are dropped (Xu 2016: 0.01, the default).
+    #[serde(default = "default_tension_threshold")]
+    pub surface_tension_threshold: f64,
+    /// Divide σ by the discrete one-sided surface-delta integral of a flat lattice surface
+    /// (≈ 0.5; see [`crate::stages::surface_tension::flat_surface_delta`]); false (Xu 2016) by
+    /// default.
+    #[serde(default)]
+    pub surface_tension_normalise: bool,
+}
+
+fn default_tension_threshold() -> f64 {
+    0.01
+}
+
+/// Surface-tension forms (see [`crate::stages::surface_tension`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceTensionModel {
+    /// Hu & Adams 2006 surface stress `Π = σ |∇c| (I/D − n̂ ⊗ n̂)` (Xu 2016).
+    #[default]
+    HuAdams,
+    /// Continuum surface force `σ κ ∇c` (Brackbill, Kothe & Zemach 1992).
+    Csf,
 }
 
 /// A region filled with particles.
@@ -451,6 +478,13 @@ pub enum Probe {
     Disorder {},
     /// Free-surface particle count `count`, PPE iterations `iterations` and residual `residual`.
     Solver {},
+    /// Largest particle speed `u_max` and root-mean-square speed `u_rms` \[m/s\] (spurious
+    /// currents of a drop at rest).
+    MaxSpeed {},
+    /// Shape of a drop: `clusters`, the number of separate bodies (particles linked by
+    /// pairs closer than 2 Δx), and `r_max`, the largest distance of a particle from the
+    /// centroid \[m\].
+    DropShape {},
     /// Velocity profile across a channel: the fluid in `range` along `axis` (optionally only
     /// where `slab.axis` lies in `slab.range`) is split into equal bins; each bin
     /// records the mean position `y_###` \[m\] and the mean velocity component `u_###`

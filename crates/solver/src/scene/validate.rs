@@ -31,6 +31,14 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     positive("fluid.density", scene.fluid.density)?;
     non_negative("fluid.viscosity", scene.fluid.viscosity)?;
     non_negative("fluid.surface_tension", scene.fluid.surface_tension)?;
+    positive("fluid.surface_tension_threshold", scene.fluid.surface_tension_threshold)?;
+    if scene.fluid.surface_tension_threshold >= 1.0 {
+        return Err(SceneError::new(
+            "fluid.surface_tension_threshold",
+            scene.fluid.surface_tension_threshold,
+            "must be below 1 (|∇c| is about 0.3/h at a free surface; Xu 2016 uses 0.01)",
+        ));
+    }
     if !scene.body_force.is_empty() {
         vector("body_force", &scene.body_force, d)?;
     }

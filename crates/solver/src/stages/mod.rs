@@ -1,8 +1,9 @@
 //! Stages shared by every scheme: reordering, walls (mirror and dummy particles), neighbour search with the pair cache,
-//! free-surface detection.
+//! free-surface detection, surface tension.
 
 pub mod dummy;
 pub mod free_surface;
 pub mod neighbours;
 pub mod reorder;
+pub mod surface_tension;
 pub mod walls;

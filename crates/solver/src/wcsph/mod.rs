@@ -20,6 +20,7 @@ use crate::kernel::{Kernel, Scaled};
 use crate::scene::{Scene, WallModel, WcsphOptions};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
+use crate::stages::surface_tension::{Apply, SurfaceTension};
 use crate::stages::{neighbours::Neighbours, reorder::Reorder, walls};
 use crate::state::Vector;
 use eos::Tait;
@@ -67,8 +68,21 @@ pub fn build_stages<K: Kernel, const D: usize>(
         }
         v
     };
+    let sigma = crate::stages::surface_tension::effective_sigma(scene, &kernel);
+    let tension = || -> Option<Box<dyn Stage<D>>> {
+        (sigma > 0.0).then(|| {
+            Box::new(SurfaceTension::new(
+                sigma,
+                scene.fluid.surface_tension_model,
+                scene.fluid.surface_tension_threshold,
+                kernel.h,
+                Apply::Acceleration,
+            )) as Box<dyn Stage<D>>
+        })
+    };
     let mut prime = boundaries();
     prime.push(forces::momentum(params));
+    prime.extend(tension());
     let mut stages: Vec<Box<dyn Stage<D>>> = vec![
         Box::new(Reorder::new(kernel.support, domain, REORDER_EVERY)),
         Box::new(integrator::Prime::new(eos, prime)),
@@ -80,6 +94,7 @@ pub fn build_stages<K: Kernel, const D: usize>(
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Pressure)));
     }
     stages.push(forces::momentum(params));
+    stages.extend(tension());
     stages.push(Box::new(integrator::Kick));
     stages
 }
