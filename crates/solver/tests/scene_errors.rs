@@ -160,6 +160,9 @@ fn malformed_scene_table() {
         ("scheme.wcsph.density_diffusion", "at most 1", |v| {
             v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "density_diffusion": 3.0}})
         }),
+        ("scheme.wcsph.continuity", "", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "continuity": "exact"}})
+        }),
         ("scheme.wcsph.c0", "unknown field", |v| {
             v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "c0": 1.0}})
         }),

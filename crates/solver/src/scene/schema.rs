@@ -305,6 +305,23 @@ pub struct WcsphOptions {
     /// Molteni–Colagrossi density diffusion coefficient δ (none if absent; 0.1 is usual).
     #[serde(default)]
     pub density_diffusion: Option<f64>,
+    /// Velocity divergence of the continuity equation.
+    #[serde(default)]
+    pub continuity: ContinuityForm,
+}
+
+/// Velocity divergence of the weakly compressible continuity equation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContinuityForm {
+    /// Liu & Liu 2003 eq. 4.32: `dρ_a/dt = Σ_b m u_ab·∇_aW_ab`.
+    #[default]
+    Standard,
+    /// `dρ_a/dt = −ρ_a tr(G_a M_a⁻¹)`, `G_a = Σ_b V_b (u_b − u_a) ⊗ ∇_aW_ab`,
+    /// `M_a = Σ_b V_b (r_b − r_a) ⊗ ∇_aW_ab` (Bonet & Lok 1999 kernel-gradient correction):
+    /// exact for linear velocity fields, also where the support is truncated by a free
+    /// surface.
+    Corrected,
 }
 
 fn default_gamma() -> f64 {

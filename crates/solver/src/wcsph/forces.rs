@@ -6,7 +6,9 @@
 //! - continuity (Liu & Liu 2003, *Smoothed Particle Hydrodynamics*, eq. 4.32; Monaghan 1992
 //!   eq. 2.17): `dρ_a/dt = Σ_b m u_ab·∇_aW_ab`, evaluated at the mid-step separation
 //!   `r_ab^{n+½} = r_ab^{n+1} − ½Δt u_ab^{n+½}` (so that the density update is the
-//!   second-order leapfrog step of [`super::integrator`]);
+//!   second-order leapfrog step of [`super::integrator`]); or, with
+//!   `"continuity": "corrected"`, `dρ_a/dt = −ρ_a tr(G_a M_a⁻¹)` with the Bonet & Lok 1999
+//!   moment matrix (exact for linear velocity fields, also at a free surface);
 //! - density diffusion (Molteni & Colagrossi 2009, Comput. Phys. Commun. 180:861, eq. 11;
 //!   optional): `+ δ h c₀ Σ_b 2 (m/ρ_b) (ρ_a − ρ_b) (r_ab·∇_aW_ab)/(r² + η²)`;
 //! - pressure gradient (Monaghan 1992, Annu. Rev. Astron. Astrophys. 30:543, eq. 3.3):
@@ -26,6 +28,7 @@ use crate::error::Cause;
 use crate::kernel::{Kernel, Scaled};
 use crate::stage::{Stage, StepContext};
 use crate::state::{State, Vector};
+use nalgebra::SMatrix;
 use rayon::prelude::*;
 
 /// Physical and numerical parameters of [`Forces`].
@@ -53,28 +56,34 @@ pub struct ForceParams<const D: usize> {
 
 /// Writes the fluid's `dρ/dt` (continuity, density diffusion) at the mid-step geometry,
 /// then advances `ρ^{n+1} = ρⁿ + Δt dρ/dt` and `p^{n+1} = p(ρ^{n+1})`, and refreshes the
-/// pressure of mirror particles from their sources. `DIFF`: density diffusion.
+/// pressure of mirror particles from their sources. `DIFF`: density diffusion; `CORR`: the
+/// kernel-gradient-corrected divergence ([`crate::scene::ContinuityForm::Corrected`]).
 #[derive(Debug)]
-pub struct Continuity<K: Kernel, const D: usize, const DIFF: bool> {
+pub struct Continuity<K: Kernel, const D: usize, const DIFF: bool, const CORR: bool> {
     /// Parameters.
     pub params: ForceParams<D>,
     /// The kernel.
     pub kernel: Scaled<K, D>,
 }
 
-/// The [`Continuity`] stage with exactly the terms `params` needs.
+/// The [`Continuity`] stage with exactly the terms `params` needs (`corrected`: the
+/// kernel-gradient-corrected divergence).
 pub fn continuity<K: Kernel, const D: usize>(
     params: ForceParams<D>,
     kernel: Scaled<K, D>,
+    corrected: bool,
 ) -> Box<dyn Stage<D>> {
-    if params.delta > 0.0 {
-        Box::new(Continuity::<K, D, true> { params, kernel })
-    } else {
-        Box::new(Continuity::<K, D, false> { params, kernel })
+    match (params.delta > 0.0, corrected) {
+        (true, false) => Box::new(Continuity::<K, D, true, false> { params, kernel }),
+        (false, false) => Box::new(Continuity::<K, D, false, false> { params, kernel }),
+        (true, true) => Box::new(Continuity::<K, D, true, true> { params, kernel }),
+        (false, true) => Box::new(Continuity::<K, D, false, true> { params, kernel }),
     }
 }
 
-impl<K: Kernel, const D: usize, const DIFF: bool> Stage<D> for Continuity<K, D, DIFF> {
+impl<K: Kernel, const D: usize, const DIFF: bool, const CORR: bool> Stage<D>
+    for Continuity<K, D, DIFF, CORR>
+{
     fn name(&self) -> &'static str {
         "continuity"
     }
@@ -94,15 +103,28 @@ impl<K: Kernel, const D: usize, const DIFF: bool> Stage<D> for Continuity<K, D, 
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let (ra, ua) = (rho[a], u[a]);
             let mut sum = 0.0;
+            let mut g = SMatrix::<f64, D, D>::zeros();
+            let mut mm = SMatrix::<f64, D, D>::zeros();
             for (pair, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                 let b = b as usize;
                 let u_ab = ua - u[b];
                 let r_mid = pair.r_ab - u_ab * half;
-                sum += m * k.grad_factor(r_mid.norm()) * u_ab.dot(&r_mid);
+                let f_mid = k.grad_factor(r_mid.norm());
+                if CORR {
+                    let grad = r_mid * (f_mid * m / rho[b]);
+                    g -= u_ab * grad.transpose();
+                    mm -= r_mid * grad.transpose();
+                } else {
+                    sum += m * f_mid * u_ab.dot(&r_mid);
+                }
                 if DIFF {
                     let rb = rho[b];
                     sum += diff_c * (ra - rb) * pair.f * pair.r2 / ((pair.r2 + eta2) * rb);
                 }
+            }
+            if CORR {
+                // Fallback (singular moment matrix, e.g. an isolated particle): Σ V ∇W form.
+                sum -= ra * mm.try_inverse().map_or(g.trace(), |mi| (g * mi).trace());
             }
             *drho = sum;
         });

@@ -89,7 +89,11 @@ pub fn build_stages<K: Kernel, const D: usize>(
         Box::new(integrator::KickDrift),
     ];
     stages.extend(boundaries());
-    stages.push(forces::continuity(params, kernel));
+    stages.push(forces::continuity(
+        params,
+        kernel,
+        opts.continuity == crate::scene::ContinuityForm::Corrected,
+    ));
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Pressure)));
     }
