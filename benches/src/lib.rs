@@ -68,7 +68,7 @@ pub fn scenes() -> Vec<BenchScene> {
 /// `scene` with its PPE solved by `solver` (Krylov tolerance 1e-3, the paper's).
 pub fn with_ppe_solver(scene: &Scene, solver: PpeSolver) -> Scene {
     let mut s = scene.clone();
-    let Scheme::Isph(opts) = &mut s.scheme;
+    let Scheme::Isph(opts) = &mut s.scheme else { return s };
     opts.ppe.solver = solver;
     opts.ppe.tolerance = 1e-3;
     s
@@ -77,7 +77,7 @@ pub fn with_ppe_solver(scene: &Scene, solver: PpeSolver) -> Scene {
 /// `scene` with the given shifting law.
 pub fn with_shifting(scene: &Scene, shifting: Shifting) -> Scene {
     let mut s = scene.clone();
-    let Scheme::Isph(opts) = &mut s.scheme;
+    let Scheme::Isph(opts) = &mut s.scheme else { return s };
     opts.shifting = shifting;
     s
 }
@@ -85,7 +85,7 @@ pub fn with_shifting(scene: &Scene, shifting: Shifting) -> Scene {
 /// `scene` with the kernel-corrected velocity divergence on the PPE source.
 pub fn with_corrected_divergence(scene: &Scene) -> Scene {
     let mut s = scene.clone();
-    let Scheme::Isph(opts) = &mut s.scheme;
+    let Scheme::Isph(opts) = &mut s.scheme else { return s };
     opts.divergence = meniscus::scene::Divergence::Corrected;
     s
 }
@@ -232,7 +232,7 @@ mod tests {
             meniscus::scene::validate(&b.scene).unwrap();
         }
         let direct = with_ppe_solver(&s[0].scene, PpeSolver::Direct);
-        let Scheme::Isph(o) = &direct.scheme;
+        let Scheme::Isph(o) = &direct.scheme else { panic!("an ISPH scene") };
         assert_eq!(o.ppe.solver, PpeSolver::Direct);
     }
 }

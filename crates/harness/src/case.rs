@@ -160,6 +160,34 @@ pub enum ReferenceSpec {
         /// Position of the lower wall \[m\].
         wall: f64,
     },
+    /// A 2D drop at rest: Laplace pressure `σ/R` and spurious currents
+    /// (`meniscus_reference::capillarity`).
+    StaticDrop {
+        /// Radius R \[m\].
+        radius: f64,
+        /// Surface tension σ \[N/m\].
+        sigma: f64,
+    },
+    /// Mode-2 oscillation of a 2D drop: period `2π √(ρR³/(6σ))` and damping `4ν/R²` (ν from
+    /// each run's scene).
+    OscillatingDrop {
+        /// Radius R \[m\].
+        radius: f64,
+        /// Surface tension σ \[N/m\].
+        sigma: f64,
+        /// Density \[kg/m^3\].
+        density: f64,
+    },
+    /// A 2D square of side L relaxing to a circle of radius `L/√π`: Laplace pressure,
+    /// connectivity, circularity and the mode-4 period.
+    SquareDrop {
+        /// Side L \[m\].
+        side: f64,
+        /// Surface tension σ \[N/m\].
+        sigma: f64,
+        /// Density \[kg/m^3\].
+        density: f64,
+    },
     /// Plane Poiseuille start-up from rest (`meniscus_reference::poiseuille`); viscosity and
     /// body force come from each run's scene.
     PoiseuilleStartup {
@@ -352,7 +380,7 @@ mod tests {
         assert_eq!(case.spacings(Tier::Quick), [0.04, 0.02]);
         assert_eq!(case.spacings(Tier::Full).len(), 4);
         assert_eq!(case.primary_preset(), "paper");
-        assert_eq!(case.presets(Tier::Quick).count(), 2);
+        assert_eq!(case.presets(Tier::Quick).count(), 4);
         assert!(case.checks.len() >= 8);
         assert!(!case.errata.is_empty());
     }

@@ -139,24 +139,37 @@ mod tests {
         let slugs: Vec<&str> = runs.iter().map(|r| r.slug.as_str()).collect();
         assert_eq!(
             slugs,
-            ["isph-paper_dx0.04", "isph-tuned_dx0.04", "isph-paper_dx0.02", "isph-tuned_dx0.02"]
+            [
+                "isph-paper_dx0.04",
+                "isph-tuned_dx0.04",
+                "wcsph-wcsph_paper_dx0.04",
+                "wcsph-wcsph_tuned_dx0.04",
+                "isph-paper_dx0.02",
+                "isph-tuned_dx0.02",
+                "wcsph-wcsph_paper_dx0.02",
+                "wcsph-wcsph_tuned_dx0.02"
+            ]
         );
-        assert!((runs[2].scene.dx - 0.02).abs() < 1e-15);
+        assert!((runs[4].scene.dx - 0.02).abs() < 1e-15);
         // The tuned preset's merge patch replaces Xu shifting by Fickian shifting.
         assert_eq!(runs[1].scene_json["scheme"]["isph"]["divergence"], "corrected");
         assert!(runs[1].scene_json["scheme"]["isph"]["shifting"].get("xu").is_none());
         assert_eq!(runs[1].scene_json["scheme"]["isph"]["shifting"]["fickian"]["coefficient"], 2.0);
         assert!(runs[0].scene_json["scheme"]["isph"]["shifting"].get("xu").is_some());
+        // The WCSPH presets replace the scheme (and the fixed step by the adaptive one).
+        assert!(runs[2].scene_json["scheme"].get("isph").is_none());
+        assert_eq!(runs[2].scene_json["scheme"]["wcsph"]["sound_speed"], 1000.0);
+        assert!(runs[2].scene_json["time"]["step"].get("adaptive").is_some());
         assert_eq!(runs[0].hash.len(), 64);
         assert_ne!(runs[0].hash, runs[1].hash);
-        assert_ne!(runs[0].hash, runs[2].hash);
+        assert_ne!(runs[0].hash, runs[4].hash);
         let full = expand(&case(), Tier::Full).unwrap();
-        assert_eq!(full.len(), 8);
+        assert_eq!(full.len(), 16);
         // Δt scales with dx below the template's 0.02 (CFL number kept), not above it.
         let dt = |r: &RunSpec| r.scene_json["time"]["step"]["fixed"].as_f64().unwrap();
         assert!((dt(&full[0]) - 2e-5).abs() < 1e-18, "dx = 0.04 keeps the paper's dt");
-        assert!((dt(&full[2]) - 2e-5).abs() < 1e-18);
-        assert!((dt(&full[6]) - 5e-6).abs() < 1e-18, "dx = 0.005: {}", dt(&full[6]));
+        assert!((dt(&full[4]) - 2e-5).abs() < 1e-18);
+        assert!((dt(&full[12]) - 5e-6).abs() < 1e-18, "dx = 0.005: {}", dt(&full[12]));
     }
 
     #[test]

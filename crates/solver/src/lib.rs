@@ -1,7 +1,8 @@
 //! # Meniscus solver
 //!
 //! Particle methods for viscous free-surface and channel flows: projection ISPH
-//! (Qiu 2013, Acta Phys. Sin. 62:124702, with the errata of CASES.md), dimension-generic
+//! (Qiu 2013, Acta Phys. Sin. 62:124702, with the errata of CASES.md) and weakly
+//! compressible SPH ([`wcsph`]), dimension-generic
 //! (`const D: usize`) over `nalgebra::SVector<f64, D>`.
 //!
 //! A [`scene::Scene`] (JSON) describes a run; [`run::AnySimulation`] builds the particles
@@ -22,6 +23,7 @@ pub mod stage;
 pub mod stages;
 pub mod state;
 pub mod two_level;
+pub mod wcsph;
 
 pub use error::{Cause, SceneError, SolverError};
 pub use probes::ProbeRecord;

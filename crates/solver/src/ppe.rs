@@ -349,7 +349,7 @@ mod tests {
         let a = strip(400, 8);
         let n = a.n();
         let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
-        let mut solve = |preconditioner, solver| {
+        let solve = |preconditioner, solver| {
             let opts = PpeOptions { solver, tolerance: 1e-10, max_iterations: 20_000, preconditioner };
             let mut p = vec![0.0; n];
             let info = PpeSolve::new(opts).solve(&a, &b, &mut p, false).expect("converges");

@@ -53,6 +53,9 @@ pub struct ProbeSet<const D: usize> {
     search: Option<(CellSearch<D>, NeighbourList)>,
     /// Scratch of the velocity profiles: per bin Σ position, Σ velocity, count.
     bins: (Vec<f64>, Vec<f64>, Vec<usize>),
+    /// Own neighbour search of the drop-shape probe (pairs closer than 2 Δx) and its
+    /// union-find parents.
+    clusters: Option<(CellSearch<D>, NeighbourList, Vec<u32>)>,
 }
 
 impl<const D: usize> ProbeSet<D> {
@@ -73,7 +76,11 @@ impl<const D: usize> ProbeSet<D> {
             .iter()
             .any(|(_, p)| matches!(p, Probe::Disorder {}))
             .then(|| (CellSearch::new(dx, domain), NeighbourList::default()));
-        Self { probes, weight, search, bins: Default::default() }
+        let clusters = probes
+            .iter()
+            .any(|(_, p)| matches!(p, Probe::DropShape {}))
+            .then(|| (CellSearch::new(2.0 * dx, domain), NeighbourList::default(), Vec::new()));
+        Self { probes, weight, search, bins: Default::default(), clusters }
     }
 
     /// Appends one sample of every probe at time `t`.
@@ -174,6 +181,23 @@ impl<const D: usize> ProbeSet<D> {
                     out.push(key, "inflow", s.flux.inflow);
                     out.push(key, "outflow", s.flux.outflow);
                 }
+                Probe::MaxSpeed {} => {
+                    let n = u.len().max(1) as f64;
+                    let (max2, sum2) =
+                        u.iter().map(|v| v.norm_squared()).fold((0.0f64, 0.0), |(m, s), v| (m.max(v), s + v));
+                    out.push(key, "u_max", max2.sqrt());
+                    out.push(key, "u_rms", (sum2 / n).sqrt());
+                }
+                Probe::DropShape {} => {
+                    let (search, list, parent) =
+                        self.clusters.as_mut().expect("built for a drop-shape probe");
+                    search.build(x, list);
+                    out.push(key, "clusters", count_clusters(list, x.len(), parent) as f64);
+                    let n = x.len().max(1) as f64;
+                    let c: Vector<D> = x.iter().sum::<Vector<D>>() / n;
+                    let r_max = x.iter().map(|p| (p - c).norm()).fold(0.0, f64::max);
+                    out.push(key, "r_max", r_max);
+                }
                 Probe::Solver {} => {
                     out.push(key, "free_surface_count", s.free_surface.iter().filter(|&&f| f).count() as f64);
                     out.push(key, "iterations", s.ppe.info.iterations as f64);
@@ -203,6 +227,29 @@ fn disorder<const D: usize>(s: &State<D>, list: &NeighbourList) -> (f64, f64) {
     (min, close as f64 / x.len().max(1) as f64)
 }
 
+/// Number of connected components of the graph of `n` particles with the edges of `list`
+/// (union-find with path halving; `parent` is scratch).
+fn count_clusters(list: &NeighbourList, n: usize, parent: &mut Vec<u32>) -> usize {
+    fn root(parent: &mut [u32], mut a: usize) -> usize {
+        while parent[a] as usize != a {
+            parent[a] = parent[parent[a] as usize];
+            a = parent[a] as usize;
+        }
+        a
+    }
+    parent.clear();
+    parent.extend(0..n as u32);
+    for a in 0..n {
+        for &b in list.of(a) {
+            let (ra, rb) = (root(parent, a), root(parent, b as usize));
+            if ra != rb {
+                parent[ra.max(rb)] = ra.min(rb) as u32;
+            }
+        }
+    }
+    (0..n).filter(|&a| root(parent, a) == a).count()
+}
+
 /// Output key of a probe kind.
 pub fn kind_name(p: &Probe) -> &'static str {
     match p {
@@ -214,5 +261,7 @@ pub fn kind_name(p: &Probe) -> &'static str {
         Probe::Solver {} => "solver",
         Probe::VelocityProfile { .. } => "velocity_profile",
         Probe::MassBalance {} => "mass_balance",
+        Probe::MaxSpeed {} => "max_speed",
+        Probe::DropShape {} => "drop_shape",
     }
 }

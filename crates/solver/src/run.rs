@@ -102,6 +102,14 @@ impl RunReport {
     }
 }
 
+/// α_f of the weakly compressible scheme's force limit `Δt ≤ α_f √(h/|a|_max)` (Monaghan
+/// 1992, Annu. Rev. Astron. Astrophys. 30:543, §10).
+const WCSPH_FORCE_LIMIT: f64 = 0.25;
+
+/// Coefficient of the capillary time-step limit `Δt ≤ 0.25 √(ρ h³/(2π σ))` (Brackbill,
+/// Kothe & Zemach 1992 eq. 63; Morris 2000), applied to both schemes when σ > 0.
+const CAPILLARY_LIMIT: f64 = 0.25;
+
 /// A simulation of dimension D, built from a scene.
 #[derive(Debug)]
 pub struct Simulation<const D: usize> {
@@ -316,6 +324,7 @@ impl<const D: usize> Simulation<D> {
             buffer,
             flux: Default::default(),
             inlet: open.as_ref().map(|o| o.link.clone()).unwrap_or_default(),
+            wc: Default::default(),
         };
         let (stages, weight) = match scene.kernel.kind {
             KernelKind::CubicSpline => build::<CubicSpline, D>(scene, h, domain, open.as_ref()),
@@ -470,9 +479,32 @@ impl<const D: usize> Simulation<D> {
                     dt = dt.min(cfl * h / u);
                 }
                 let mu = self.scene.fluid.viscosity;
-                let Scheme::Isph(opts) = &self.scene.scheme;
-                if mu > 0.0 && opts.viscosity == crate::scene::ViscousIntegration::Explicit {
-                    dt = dt.min(viscous * self.state.density * h * h / mu);
+                match &self.scene.scheme {
+                    Scheme::Isph(opts) => {
+                        if mu > 0.0 && opts.viscosity == crate::scene::ViscousIntegration::Explicit {
+                            dt = dt.min(viscous * self.state.density * h * h / mu);
+                        }
+                    }
+                    Scheme::Wcsph(opts) => {
+                        // Monaghan 1992 §10: the sound speed enters the CFL; force limit.
+                        dt = dt.min(cfl * h / (opts.sound_speed + u));
+                        if mu > 0.0 {
+                            dt = dt.min(viscous * self.state.density * h * h / mu);
+                        }
+                        let a =
+                            self.state.wc.accel.iter().map(|a| a.norm_squared()).fold(0.0, f64::max).sqrt();
+                        if a > 0.0 {
+                            dt = dt.min(WCSPH_FORCE_LIMIT * (h / a).sqrt());
+                        }
+                    }
+                }
+                let sigma = self.scene.fluid.surface_tension;
+                if sigma > 0.0 {
+                    // Capillary waves (Brackbill, Kothe & Zemach 1992 eq. 63; Morris 2000).
+                    dt = dt.min(
+                        CAPILLARY_LIMIT
+                            * (self.state.density * h * h * h / (2.0 * std::f64::consts::PI * sigma)).sqrt(),
+                    );
                 }
                 let floor = 1e-9 * self.scene.time.end;
                 if dt < floor {
@@ -665,6 +697,7 @@ fn build<K: Kernel, const D: usize>(
     let kernel = Scaled::<K, D>::new(h);
     let stages = match &scene.scheme {
         Scheme::Isph(opts) => crate::isph::build_stages::<K, D>(scene, opts, kernel, domain, open),
+        Scheme::Wcsph(opts) => crate::wcsph::build_stages::<K, D>(scene, opts, kernel, domain),
     };
     (stages, Weight { w: Box::new(move |r| kernel.w(r)), support: kernel.support })
 }

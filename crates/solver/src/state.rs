@@ -91,6 +91,8 @@ pub struct State<const D: usize> {
     pub ppe: PpeSystem,
     /// Where each mirror particle's values come from.
     pub mirrors: Mirrors,
+    /// Weakly compressible scheme only (empty otherwise): per-particle data.
+    pub wc: WcFields<D>,
     /// Number of open-boundary buffer particles, stored right after the fluid (inlet
     /// buffer first, then outlet buffer); mirrors or dummy wall particles follow them.
     pub buffer: usize,
@@ -122,6 +124,20 @@ pub struct Flux {
     pub inflow: f64,
     /// Mass that left through the outlet.
     pub outflow: f64,
+}
+
+/// Per-particle data of the weakly compressible scheme ([`crate::wcsph`]); empty vectors
+/// for the projection scheme.
+#[derive(Debug, Clone, Default)]
+pub struct WcFields<const D: usize> {
+    /// Density ρ \[kg/m³\]: the fluid first (integrated), then the boundary particles
+    /// (from their pressure by the inverse Tait equation, every force evaluation).
+    pub rho: Vec<f64>,
+    /// dρ/dt of the fluid at the last force evaluation \[kg/(m³ s)\].
+    pub drho: Vec<f64>,
+    /// Acceleration of the fluid at the last force evaluation \[m/s²\] (all forces:
+    /// pressure, viscosity, body force, surface tension).
+    pub accel: Vec<Vector<D>>,
 }
 
 /// Boundary particles that mirror fluid particles: boundary particle `fluid + k` takes its
@@ -182,5 +198,8 @@ impl<const D: usize> State<D> {
         apply(&mut self.u_old, perm);
         apply(&mut self.free_surface, perm);
         apply(&mut self.div_r, perm);
+        apply(&mut self.wc.rho, perm);
+        apply(&mut self.wc.drho, perm);
+        apply(&mut self.wc.accel, perm);
     }
 }

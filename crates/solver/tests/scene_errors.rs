@@ -110,6 +110,13 @@ fn malformed_scene_table() {
         ("fluid.density", "", |v| v["fluid"]["density"] = json!([1000.0])),
         ("fluid.viscosity", "negative", |v| v["fluid"]["viscosity"] = json!(-1.0)),
         ("fluid.surface_tension", "negative", |v| v["fluid"]["surface_tension"] = json!(-0.07)),
+        ("fluid.surface_tension_model", "", |v| v["fluid"]["surface_tension_model"] = json!("marangoni")),
+        ("fluid.surface_tension_threshold", "positive", |v| {
+            v["fluid"]["surface_tension_threshold"] = json!(-0.01)
+        }),
+        ("fluid.surface_tension_threshold", "below 1", |v| {
+            v["fluid"]["surface_tension_threshold"] = json!(2.0)
+        }),
         ("kernel.h_over_dx", "positive", |v| v["kernel"]["h_over_dx"] = json!(0)),
         ("kernel.h_over_dx", "at most 4", |v| v["kernel"]["h_over_dx"] = json!(10)),
         ("kernel.h_over_dx", "", |v| v["kernel"]["h_over_dx"] = json!(true)),
@@ -138,7 +145,36 @@ fn malformed_scene_table() {
         ("scheme.isph.shifting.fickian", "missing field", |v| {
             v["scheme"]["isph"]["shifting"] = json!({"xu": {}, "fickian": {}})
         }),
-        ("scheme", "", |v| v["scheme"] = json!({"wcsph": {}})),
+        // `sound_speed` is required.
+        ("scheme.wcsph", "sound_speed", |v| v["scheme"] = json!({"wcsph": {}})),
+        ("scheme", "", |v| v["scheme"] = json!({"mps": {}})),
+        ("scheme.wcsph.sound_speed", "positive", |v| v["scheme"] = json!({"wcsph": {"sound_speed": -10.0}})),
+        ("scheme.wcsph.sound_speed", "positive", |v| v["scheme"] = json!({"wcsph": {"sound_speed": 0.0}})),
+        ("scheme.wcsph.gamma", "1..=10", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "gamma": 0.5}})
+        }),
+        ("scheme.wcsph.artificial_viscosity.alpha", "negative", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "artificial_viscosity": {"alpha": -0.1}}})
+        }),
+        ("scheme.wcsph.artificial_viscosity.beta", "negative", |v| {
+            v["scheme"] =
+                json!({"wcsph": {"sound_speed": 10.0, "artificial_viscosity": {"alpha": 0.1, "beta": -2.0}}})
+        }),
+        ("scheme.wcsph.artificial_viscosity.alpha", "at most 10", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "artificial_viscosity": {"alpha": 50.0}}})
+        }),
+        ("scheme.wcsph.density_diffusion", "negative", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "density_diffusion": -0.1}})
+        }),
+        ("scheme.wcsph.density_diffusion", "at most 1", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "density_diffusion": 3.0}})
+        }),
+        ("scheme.wcsph.continuity", "", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "continuity": "exact"}})
+        }),
+        ("scheme.wcsph.c0", "unknown field", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "c0": 1.0}})
+        }),
         // Time.
         ("time.end", "positive", |v| v["time"]["end"] = json!(0)),
         ("time.end", "positive", |v| v["time"]["end"] = json!(-0.008)),

@@ -6,6 +6,7 @@
 //! `<quantity>_rel_err_final` (at the last sample), `<quantity>_drift` (largest
 //! `|x(t) - x(0)| / |x(0)|`). Non-finite samples make the norm NaN (never silently skipped).
 
+pub mod capillarity;
 pub mod channel;
 pub mod elliptical_drop;
 pub mod poiseuille;
@@ -45,6 +46,17 @@ pub fn compute(
         ReferenceSpec::RotatingSquare { side, omega, density } => {
             let patch = meniscus_reference::rotating_square::RotatingSquare::new(side, omega, density)?;
             rotating_square::compute(&patch, &rotating_square::pressure_points(scene), probes)?
+        }
+        ReferenceSpec::StaticDrop { radius, sigma } => {
+            capillarity::compute(&capillarity::Capillary::Static { radius, sigma }, probes)?
+        }
+        ReferenceSpec::OscillatingDrop { radius, sigma, density } => {
+            let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
+            let nu = num(&scene["fluid"]["viscosity"]) / num(&scene["fluid"]["density"]);
+            capillarity::compute(&capillarity::Capillary::Oscillating { radius, sigma, density, nu }, probes)?
+        }
+        ReferenceSpec::SquareDrop { side, sigma, density } => {
+            capillarity::compute(&capillarity::Capillary::Square { side, sigma, density }, probes)?
         }
     };
     m.metrics.insert("particles".into(), particles as f64);

@@ -895,7 +895,7 @@ mod tests {
         for (set, _) in OPTION_SETS {
             let v = base.scene(set, |_| {}).unwrap();
             let scene = meniscus::Scene::from_json(&v.to_string()).unwrap_or_else(|e| panic!("{set}: {e}"));
-            let meniscus::scene::Scheme::Isph(o) = &scene.scheme;
+            let meniscus::scene::Scheme::Isph(o) = &scene.scheme else { panic!("{set}: not an ISPH scene") };
             match set {
                 "none" => assert_eq!(o.shifting, meniscus::scene::Shifting::None),
                 "fickian" => assert!(matches!(o.shifting, meniscus::scene::Shifting::Fickian { .. })),

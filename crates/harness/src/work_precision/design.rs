@@ -189,7 +189,9 @@ impl Variant {
 
     /// Applies the variant to a drop scene whose fixed Δt is the case's.
     pub fn apply(&self, scene: &mut Scene) {
-        let Scheme::Isph(o) = &mut scene.scheme;
+        let Scheme::Isph(o) = &mut scene.scheme else {
+            return; // the variants are ISPH options
+        };
         (o.ppe.solver, o.ppe.tolerance) = match self.ppe {
             Ppe::Bicgstab3 => (PpeSolver::Bicgstab, 1e-3),
             Ppe::Bicgstab5 => (PpeSolver::Bicgstab, 1e-5),
@@ -398,7 +400,7 @@ mod tests {
             dt: Dt::Adaptive,
         };
         let s = scene(&c, &v, 0.02).unwrap();
-        let Scheme::Isph(o) = &s.scheme;
+        let Scheme::Isph(o) = &s.scheme else { panic!("an ISPH scene") };
         assert_eq!(o.ppe.solver, PpeSolver::Cg);
         assert_eq!(o.pressure_gradient, PressureGradient::Difference);
         assert_eq!(o.divergence, Divergence::Corrected);

@@ -4,7 +4,7 @@
 //! `reorder` (locality) → `advect` (eq. 3) → `walls` (§2.4.2; mirror walls only) →
 //! `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation) →
 //! `inlet_sources` (inflow only) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
-//! (eq. 4; g ≠ 0 only) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
+//! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
 //! `mirror_velocity` | `dummy_velocity` (walls only) → `ppe_assemble`
 //! (eqs. 10, 12) → `ppe_solve` (eq. 5) → `dummy_pressure` (dummy walls only) →
 //! `correction` (eqs. 6, 15) → `position` (eq. 7) →
@@ -24,6 +24,7 @@ use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
+use crate::stages::surface_tension::{Apply, SurfaceTension};
 use crate::stages::{free_surface::FreeSurface, reorder::Reorder, walls};
 use crate::state::Vector;
 
@@ -86,6 +87,15 @@ pub fn build_stages<K: Kernel, const D: usize>(
     }
     if g.norm_squared() > 0.0 {
         stages.push(Box::new(predictor::BodyForce { g }));
+    }
+    if scene.fluid.surface_tension > 0.0 {
+        stages.push(Box::new(SurfaceTension::new(
+            crate::stages::surface_tension::effective_sigma(scene, &kernel),
+            scene.fluid.surface_tension_model,
+            scene.fluid.surface_tension_threshold,
+            kernel.h,
+            Apply::Velocity,
+        )));
     }
     if nu > 0.0 && implicit {
         stages.push(Box::new(implicit_viscosity::ImplicitViscosity::new(nu)));

@@ -71,6 +71,33 @@ pub struct Fluid {
     /// Surface tension coefficient σ \[N/m\]; 0 (default) builds no surface-tension stage.
     #[serde(default)]
     pub surface_tension: f64,
+    /// Discretisation of the surface tension (used when σ > 0).
+    #[serde(default)]
+    pub surface_tension_model: SurfaceTensionModel,
+    /// Threshold on the colour gradient, in units of 1/h: normals with
+    /// `|∇c| ≤ surface_tension_threshold / h` are dropped (Xu 2016: 0.01, the default).
+    #[serde(default = "default_tension_threshold")]
+    pub surface_tension_threshold: f64,
+    /// Divide σ by the discrete one-sided surface-delta integral of a flat lattice surface
+    /// (≈ 0.5; see [`crate::stages::surface_tension::flat_surface_delta`]); false (Xu 2016) by
+    /// default.
+    #[serde(default)]
+    pub surface_tension_normalise: bool,
+}
+
+fn default_tension_threshold() -> f64 {
+    0.01
+}
+
+/// Surface-tension forms (see [`crate::stages::surface_tension`]).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SurfaceTensionModel {
+    /// Hu & Adams 2006 surface stress `Π = σ |∇c| (I/D − n̂ ⊗ n̂)` (Xu 2016).
+    #[default]
+    HuAdams,
+    /// Continuum surface force `σ κ ∇c` (Brackbill, Kothe & Zemach 1992).
+    Csf,
 }
 
 /// A region filled with particles.
@@ -294,6 +321,76 @@ pub struct PeriodicAxis {
 pub enum Scheme {
     /// Projection ISPH (Qiu 2013 §2.2–2.6; Cummins & Rudman 1999; Shao & Lo 2003).
     Isph(IsphOptions),
+    /// Weakly compressible SPH (Xu 2016 with the standard forms of CASES.md erratum 6):
+    /// continuity equation, Tait equation of state, kick-drift-kick integration.
+    Wcsph(WcsphOptions),
+}
+
+impl Scheme {
+    /// The scheme's key in the scene file (`isph`, `wcsph`).
+    pub fn key(&self) -> &'static str {
+        match self {
+            Scheme::Isph(_) => "isph",
+            Scheme::Wcsph(_) => "wcsph",
+        }
+    }
+}
+
+/// Options of the weakly compressible scheme (see [`crate::wcsph`]).
+///
+/// The reference density ρ₀ is `fluid.density`; every particle has the mass
+/// `m = ρ₀ Δx^D`. Pressure follows the Tait equation `p = B ((ρ/ρ₀)^γ − 1)`,
+/// `B = ρ₀ c₀² / γ` (Monaghan 1994, J. Comput. Phys. 110:399, eq. 3.3; Batchelor 1967).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WcsphOptions {
+    /// Artificial speed of sound c₀ \[m/s\] (about 10 × the largest flow speed keeps
+    /// density variations near 1 %).
+    pub sound_speed: f64,
+    /// Exponent γ of the Tait equation (7 for water, the default).
+    #[serde(default = "default_gamma")]
+    pub gamma: f64,
+    /// Monaghan artificial viscosity (none if absent).
+    #[serde(default)]
+    pub artificial_viscosity: Option<ArtificialViscosity>,
+    /// Molteni–Colagrossi density diffusion coefficient δ (none if absent; 0.1 is usual).
+    #[serde(default)]
+    pub density_diffusion: Option<f64>,
+    /// Velocity divergence of the continuity equation.
+    #[serde(default)]
+    pub continuity: ContinuityForm,
+}
+
+/// Velocity divergence of the weakly compressible continuity equation.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ContinuityForm {
+    /// Liu & Liu 2003 eq. 4.32: `dρ_a/dt = Σ_b m u_ab·∇_aW_ab`.
+    #[default]
+    Standard,
+    /// `dρ_a/dt = −ρ_a tr(G_a M_a⁻¹)`, `G_a = Σ_b V_b (u_b − u_a) ⊗ ∇_aW_ab`,
+    /// `M_a = Σ_b V_b (r_b − r_a) ⊗ ∇_aW_ab` (Bonet & Lok 1999 kernel-gradient correction):
+    /// exact for linear velocity fields, also where the support is truncated by a free
+    /// surface.
+    Corrected,
+}
+
+fn default_gamma() -> f64 {
+    7.0
+}
+
+/// Monaghan 1992 artificial viscosity (Annu. Rev. Astron. Astrophys. 30:543, eq. 4.1):
+/// `Π_ab = (−α c₀ μ_ab + β μ_ab²) / ρ̄_ab` for approaching pairs (`u_ab·r_ab < 0`),
+/// `μ_ab = h u_ab·r_ab / (r² + 0.01 h²)`, else 0.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArtificialViscosity {
+    /// α (linear, shear and bulk viscosity; Xu 2016 uses 1 for impacts, 0.01–0.1 is usual
+    /// without impacts).
+    pub alpha: f64,
+    /// β (quadratic, against interpenetration at shocks; Xu 2016 uses 2 for impacts).
+    #[serde(default)]
+    pub beta: f64,
 }
 
 /// Options of the projection ISPH scheme.
@@ -475,6 +572,13 @@ pub enum Probe {
     /// `mass` and the cumulative masses that entered, `inflow`, and left, `outflow`
     /// \[kg, per metre of depth in 2D\].
     MassBalance {},
+    /// Largest particle speed `u_max` and root-mean-square speed `u_rms` \[m/s\] (spurious
+    /// currents of a drop at rest).
+    MaxSpeed {},
+    /// Shape of a drop: `clusters`, the number of separate bodies (particles linked by
+    /// pairs closer than 2 Δx), and `r_max`, the largest distance of a particle from the
+    /// centroid \[m\].
+    DropShape {},
     /// Velocity profile across a channel: the fluid in `range` along `axis` (optionally only
     /// where `slab.axis` lies in `slab.range`) is split into equal bins; each bin
     /// records the mean position `y_###` \[m\] and the mean velocity component `u_###`

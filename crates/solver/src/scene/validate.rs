@@ -31,6 +31,14 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     positive("fluid.density", scene.fluid.density)?;
     non_negative("fluid.viscosity", scene.fluid.viscosity)?;
     non_negative("fluid.surface_tension", scene.fluid.surface_tension)?;
+    positive("fluid.surface_tension_threshold", scene.fluid.surface_tension_threshold)?;
+    if scene.fluid.surface_tension_threshold >= 1.0 {
+        return Err(SceneError::new(
+            "fluid.surface_tension_threshold",
+            scene.fluid.surface_tension_threshold,
+            "must be below 1 (|∇c| is about 0.3/h at a free surface; Xu 2016 uses 0.01)",
+        ));
+    }
     if !scene.body_force.is_empty() {
         vector("body_force", &scene.body_force, d)?;
     }
@@ -101,6 +109,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     }
     match &scene.scheme {
         Scheme::Isph(o) => validate_isph(o, d)?,
+        Scheme::Wcsph(o) => validate_wcsph(o)?,
     }
     positive("time.end", scene.time.end)?;
     match scene.time.step {
@@ -251,6 +260,47 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
                     "must be at most 10 (Lind 2012 uses 1–6)",
                 ));
             }
+        }
+    }
+    Ok(())
+}
+
+fn validate_wcsph(o: &WcsphOptions) -> Result<(), SceneError> {
+    positive("scheme.wcsph.sound_speed", o.sound_speed)?;
+    finite("scheme.wcsph.gamma", o.gamma)?;
+    if !(1.0..=10.0).contains(&o.gamma) {
+        return Err(SceneError::new(
+            "scheme.wcsph.gamma",
+            o.gamma,
+            "must lie in 1..=10 (the Tait exponent; 7 for water)",
+        ));
+    }
+    if let Some(av) = o.artificial_viscosity {
+        non_negative("scheme.wcsph.artificial_viscosity.alpha", av.alpha)?;
+        non_negative("scheme.wcsph.artificial_viscosity.beta", av.beta)?;
+        if av.alpha > 10.0 {
+            return Err(SceneError::new(
+                "scheme.wcsph.artificial_viscosity.alpha",
+                av.alpha,
+                "must be at most 10 (Monaghan 1992 uses about 1)",
+            ));
+        }
+        if av.beta > 10.0 {
+            return Err(SceneError::new(
+                "scheme.wcsph.artificial_viscosity.beta",
+                av.beta,
+                "must be at most 10 (Monaghan 1992 uses about 2)",
+            ));
+        }
+    }
+    if let Some(delta) = o.density_diffusion {
+        non_negative("scheme.wcsph.density_diffusion", delta)?;
+        if delta > 1.0 {
+            return Err(SceneError::new(
+                "scheme.wcsph.density_diffusion",
+                delta,
+                "must be at most 1 (Molteni & Colagrossi 2009 use 0.1)",
+            ));
         }
     }
     Ok(())

@@ -110,6 +110,13 @@ fn open_boundaries(scene: &Scene) -> Result<(), SceneError> {
         }
         (Some(i), Some(o)) => (i, o),
     };
+    if !matches!(scene.scheme, Scheme::Isph(_)) {
+        return Err(SceneError::new(
+            "boundaries.inflow",
+            "present",
+            "is supported by the isph scheme only (the wcsph step has no buffer stages yet)",
+        ));
+    }
     axis("boundaries.inflow.axis", inflow.axis, scene.dimension)?;
     finite("boundaries.inflow.position", inflow.position)?;
     finite("boundaries.inflow.velocity", inflow.velocity)?;

@@ -1,10 +1,11 @@
 //! Stages shared by every scheme: reordering, walls (mirror and dummy particles), open
 //! boundaries (inflow/outflow buffers), neighbour search with the pair cache, free-surface
-//! detection.
+//! detection, surface tension.
 
 pub mod dummy;
 pub mod free_surface;
 pub mod neighbours;
 pub mod open_boundary;
 pub mod reorder;
+pub mod surface_tension;
 pub mod walls;

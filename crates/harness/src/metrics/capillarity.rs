@@ -1,0 +1,238 @@
+//! Metrics of the capillarity cases (CASES.md "static_drop and oscillating_drop",
+//! "square_drop_tension") against `meniscus_reference::capillarity` (2D).
+//!
+//! Common: the inside pressure is the `pressure_at` probe at the drop's centre (Shepard
+//! average); as the weakly compressible pressure carries acoustic noise, the pressure jump
+//! is also averaged over the last quarter of the run (`*_late`).
+//!
+//! - static drop (`R`, `σ`): `dp_rel_err_final`, `dp_rel_err_late` against `σ/R`;
+//!   `u_spurious_max_final`, `u_spurious_max_late` (largest particle speed \[m/s\], from the
+//!   `max_speed` probe), `u_spurious_rms_late`.
+//! - oscillating drop (`R`, `σ`, `ρ`; ν from the scene): the deformation
+//!   `d(t) = a_moment − b_moment` (`ellipse_axes`); its period `period` from the mean
+//!   spacing of its zero crossings (linear interpolation; at least two crossings) and
+//!   `period_rel_err` against mode 2, `2π √(ρR³/(6σ))`; the amplitude decay rate
+//!   `damping_rate` (least-squares fit of `ln |d|` at the extremum of every half cycle)
+//!   and `damping_rel_err` against `4ν/R²`.
+//! - square drop (side `L`, `σ`, `ρ`): `R = L/√π`; `dp_rel_err_final`, `dp_rel_err_late`
+//!   against `σ/R`; `clusters_max` (largest number of separate bodies over the run, from
+//!   the `drop_shape` probe) and `r_max_over_r_final` (largest distance from the centroid
+//!   over R; 1.25 for the square, → 1 for a circle); `period` / `period_rel_err` of
+//!   `a_extent` (the x half-extent) against mode 4, `ω² = 60 σ/(ρR³)`, from the mean spacing
+//!   of its crossings of its own mean over the second half of the run.
+
+use super::Measured;
+use meniscus::ProbeRecord;
+use meniscus_reference::ReferenceError;
+use meniscus_reference::capillarity::{self, Dimension};
+
+/// Which capillarity case, with its parameters.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Capillary {
+    /// A drop at rest: radius \[m\], σ \[N/m\].
+    Static {
+        /// R \[m\].
+        radius: f64,
+        /// σ \[N/m\].
+        sigma: f64,
+    },
+    /// Mode-2 oscillation: radius \[m\], σ \[N/m\], ρ \[kg/m³\], ν \[m²/s\].
+    Oscillating {
+        /// R \[m\].
+        radius: f64,
+        /// σ \[N/m\].
+        sigma: f64,
+        /// ρ \[kg/m³\].
+        density: f64,
+        /// ν \[m²/s\] (from the scene).
+        nu: f64,
+    },
+    /// Square relaxing to a circle: side \[m\], σ \[N/m\], ρ \[kg/m³\].
+    Square {
+        /// L \[m\].
+        side: f64,
+        /// σ \[N/m\].
+        sigma: f64,
+        /// ρ \[kg/m³\].
+        density: f64,
+    },
+}
+
+/// Times of the sign changes of `v − level` (linear interpolation between samples).
+pub fn crossings(t: &[f64], v: &[f64], level: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    for i in 1..t.len().min(v.len()) {
+        let (a, b) = (v[i - 1] - level, v[i] - level);
+        if a != 0.0 && a.signum() != b.signum() && b != 0.0 || (b == 0.0 && a != 0.0) {
+            out.push(t[i - 1] + (t[i] - t[i - 1]) * a / (a - b));
+        }
+    }
+    out
+}
+
+/// Period `2 × mean spacing` of successive crossings (NaN with fewer than two).
+pub fn period_from_crossings(c: &[f64]) -> f64 {
+    if c.len() < 2 { f64::NAN } else { 2.0 * (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64 }
+}
+
+/// Mean of the samples with `t ≥ from`.
+fn mean_after(t: &[f64], v: &[f64], from: f64) -> f64 {
+    let (s, n) =
+        t.iter().zip(v).filter(|(x, _)| **x >= from).fold((0.0, 0usize), |(s, n), (_, y)| (s + y, n + 1));
+    if n == 0 { f64::NAN } else { s / n as f64 }
+}
+
+/// Least-squares slope of `y` against `x` (NaN with fewer than two points).
+fn slope(x: &[f64], y: &[f64]) -> f64 {
+    let n = x.len().min(y.len());
+    if n < 2 {
+        return f64::NAN;
+    }
+    let (mx, my) = (x.iter().sum::<f64>() / n as f64, y.iter().sum::<f64>() / n as f64);
+    let sxy: f64 = x.iter().zip(y).map(|(a, b)| (a - mx) * (b - my)).sum();
+    let sxx: f64 = x.iter().map(|a| (a - mx) * (a - mx)).sum();
+    sxy / sxx
+}
+
+/// Computes the metrics and series of one run.
+pub fn compute(case: &Capillary, probes: &ProbeRecord) -> Result<Measured, ReferenceError> {
+    let mut out = Measured::default();
+    let t = &probes.t;
+    if t.is_empty() {
+        return Ok(out);
+    }
+    let t_end = t[t.len() - 1];
+    let late = 0.75 * t_end;
+    let m = &mut out.metrics;
+    m.insert("t_final".into(), t_end);
+    out.series.insert("t".into(), t.clone());
+    let mut pressure = |dp: f64, m: &mut std::collections::BTreeMap<String, f64>| {
+        if let Some(p) = probes.get("pressure_at", "p") {
+            m.insert("dp_rel_err_final".into(), ((p[p.len() - 1] - dp) / dp).abs());
+            m.insert("dp_rel_err_late".into(), ((mean_after(t, p, late) - dp) / dp).abs());
+            m.insert("dp_late".into(), mean_after(t, p, late));
+            out.series.insert("p".into(), p.to_vec());
+            out.series.insert("dp_ref".into(), vec![dp; t.len()]);
+        }
+    };
+    match *case {
+        Capillary::Static { radius, sigma } => {
+            pressure(capillarity::laplace_pressure(Dimension::Two, sigma, radius)?, m);
+            if let Some(u) = probes.get("max_speed", "u_max") {
+                m.insert("u_spurious_max_final".into(), u[u.len() - 1]);
+                m.insert("u_spurious_max_late".into(), mean_after(t, u, late));
+                out.series.insert("u_max".into(), u.to_vec());
+            }
+            if let Some(u) = probes.get("max_speed", "u_rms") {
+                m.insert("u_spurious_rms_late".into(), mean_after(t, u, late));
+            }
+        }
+        Capillary::Oscillating { radius, sigma, density, nu } => {
+            let period_ref = capillarity::oscillation_period(Dimension::Two, 2, sigma, density, radius)?;
+            m.insert("period_ref".into(), period_ref);
+            if let (Some(a), Some(b)) =
+                (probes.get("ellipse_axes", "a_moment"), probes.get("ellipse_axes", "b_moment"))
+            {
+                let d: Vec<f64> = a.iter().zip(b).map(|(a, b)| a - b).collect();
+                let c = crossings(t, &d, 0.0);
+                let period = period_from_crossings(&c);
+                m.insert("period".into(), period);
+                m.insert("period_rel_err".into(), ((period - period_ref) / period_ref).abs());
+                // Extremum of |d| in every complete half cycle.
+                let (mut tp, mut lp) = (Vec::new(), Vec::new());
+                for w in c.windows(2) {
+                    let best = t
+                        .iter()
+                        .zip(&d)
+                        .filter(|(x, _)| **x > w[0] && **x < w[1])
+                        .max_by(|p, q| p.1.abs().total_cmp(&q.1.abs()));
+                    if let Some((x, y)) = best
+                        && y.abs() > 0.0
+                    {
+                        tp.push(*x);
+                        lp.push(y.abs().ln());
+                    }
+                }
+                let beta = -slope(&tp, &lp);
+                m.insert("damping_rate".into(), beta);
+                if nu > 0.0 {
+                    let beta_ref = capillarity::damping_rate(Dimension::Two, 2, nu, radius)?;
+                    m.insert("damping_ref".into(), beta_ref);
+                    m.insert("damping_rel_err".into(), ((beta - beta_ref) / beta_ref).abs());
+                }
+                out.series.insert("deformation".into(), d);
+            }
+        }
+        Capillary::Square { side, sigma, density } => {
+            let r = capillarity::equivalent_radius_of_square(Dimension::Two, side)?;
+            pressure(capillarity::laplace_pressure(Dimension::Two, sigma, r)?, m);
+            if let Some(c) = probes.get("drop_shape", "clusters") {
+                m.insert("clusters_max".into(), c.iter().copied().fold(0.0, f64::max));
+                out.series.insert("clusters".into(), c.to_vec());
+            }
+            if let Some(rm) = probes.get("drop_shape", "r_max") {
+                m.insert("r_max_over_r_final".into(), rm[rm.len() - 1] / r);
+                out.series.insert("r_max_over_r".into(), rm.iter().map(|x| x / r).collect());
+            }
+            let period_ref = capillarity::oscillation_period(Dimension::Two, 4, sigma, density, r)?;
+            m.insert("period_ref".into(), period_ref);
+            if let Some(a) = probes.get("ellipse_axes", "a_extent") {
+                let level = mean_after(t, a, 0.5 * t_end);
+                let period = period_from_crossings(&crossings(t, a, level));
+                m.insert("period".into(), period);
+                m.insert("period_rel_err".into(), ((period - period_ref) / period_ref).abs());
+                out.series.insert("a_extent".into(), a.to_vec());
+            }
+        }
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(t: &[f64], series: &[(&str, &str, Vec<f64>)]) -> ProbeRecord {
+        let mut r = ProbeRecord { t: t.to_vec(), ..Default::default() };
+        for (k, q, v) in series {
+            r.series.entry(k.to_string()).or_default().insert(q.to_string(), v.clone());
+        }
+        r
+    }
+
+    #[test]
+    fn period_and_damping_of_a_synthetic_oscillation() {
+        // d = 0.01 e^{−βt} cos(ωt + φ) with the mode-2 frequency of R = 0.2, σ = ρ = 1.
+        let (radius, sigma, density, nu) = (0.2, 1.0, 1.0, 5e-3);
+        let tp = capillarity::oscillation_period(Dimension::Two, 2, sigma, density, radius).unwrap();
+        let w = 2.0 * std::f64::consts::PI / tp;
+        let beta = 4.0 * nu / (radius * radius);
+        let t: Vec<f64> = (0..4000).map(|i| i as f64 * 2e-4).collect();
+        let d: Vec<f64> = t.iter().map(|x| 0.01 * (-beta * x).exp() * (w * x + 0.3).sin()).collect();
+        let a: Vec<f64> = d.iter().map(|x| 0.2 + x / 2.0).collect();
+        let b: Vec<f64> = d.iter().map(|x| 0.2 - x / 2.0).collect();
+        let r = record(&t, &[("ellipse_axes", "a_moment", a), ("ellipse_axes", "b_moment", b)]);
+        let m = compute(&Capillary::Oscillating { radius, sigma, density, nu }, &r).unwrap().metrics;
+        assert!(m["period_rel_err"] < 1e-3, "{m:?}");
+        assert!(m["damping_rel_err"] < 0.05, "{m:?}");
+        // A 10 % slower oscillation is measured as such.
+        let d2: Vec<f64> = t.iter().map(|x| (w / 1.1 * x + 0.3).sin()).collect();
+        let r2 = record(
+            &t,
+            &[("ellipse_axes", "a_moment", d2.clone()), ("ellipse_axes", "b_moment", vec![0.0; 4000])],
+        );
+        let m2 = compute(&Capillary::Oscillating { radius, sigma, density, nu }, &r2).unwrap().metrics;
+        assert!((m2["period_rel_err"] - 0.1).abs() < 2e-3, "{m2:?}");
+    }
+
+    #[test]
+    fn static_drop_pressure_jump() {
+        let t: Vec<f64> = (0..=100).map(|i| i as f64 * 0.01).collect();
+        let p: Vec<f64> = t.iter().map(|x| if *x < 0.75 { 0.0 } else { 5.25 }).collect();
+        let u = vec![1e-3; t.len()];
+        let r = record(&t, &[("pressure_at", "p", p), ("max_speed", "u_max", u)]);
+        let m = compute(&Capillary::Static { radius: 0.2, sigma: 1.0 }, &r).unwrap().metrics;
+        assert!((m["dp_rel_err_late"] - 0.05).abs() < 1e-12, "{m:?}");
+        assert!((m["u_spurious_max_late"] - 1e-3).abs() < 1e-15);
+    }
+}
