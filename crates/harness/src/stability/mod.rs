@@ -346,6 +346,42 @@ struct Runner<'a> {
 }
 
 impl Runner<'_> {
+    /// Bisects `[lo, hi]` over `iterations` trials of `base`: `scene(value)` gives the run's
+    /// slug and scene. Returns the bracket, the trials and the largest particle count; the
+    /// first error stops the bisection and is returned.
+    fn bisect_trials(
+        &mut self,
+        base: &Base,
+        (lo, hi, iterations): (f64, f64, usize),
+        mut scene: impl FnMut(f64) -> (String, Result<Value>),
+    ) -> Result<(Bracket, Vec<Trial>, usize)> {
+        let mut trials = Vec::new();
+        let mut particles = 0;
+        let mut failure = None;
+        let bracket = bisect(lo, hi, iterations, |value| {
+            if failure.is_some() {
+                return false;
+            }
+            let (slug, sc) = scene(value);
+            match sc.and_then(|sc| self.trial(base, slug, value, sc)) {
+                Ok(m) => {
+                    particles = particles.max(m.particles);
+                    let stable = m.trial.stable;
+                    trials.push(m.trial);
+                    stable
+                }
+                Err(e) => {
+                    failure = Some(e);
+                    false
+                }
+            }
+        });
+        match failure {
+            Some(e) => Err(e),
+            None => Ok((bracket, trials, particles)),
+        }
+    }
+
     /// Runs `scene` (cached by scene hash) and measures it against `base`'s reference.
     fn trial(&mut self, base: &Base, slug: String, value: f64, scene: Value) -> Result<Measured> {
         let parsed = meniscus::Scene::from_json(&scene.to_string())
@@ -622,40 +658,19 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
     for set in &s.option_sets {
         // Largest stable multiple of the adaptive step.
         for (base, time) in [(&drop, &drop_time as &dyn Fn(&mut Value)), (&channel, &channel_time)] {
-            let mut trials = Vec::new();
-            let mut particles = 0;
-            let mut failure = None;
             let template_max =
                 crate::sweep::effective_scene(&base.case, base.preset, base.dx)?["time"]["step"]["adaptive"]
                     ["max"]
                     .as_f64()
                     .unwrap_or(1e-3);
-            let bracket = bisect(s.dt_range[0], s.dt_range[1], s.dt_iterations, |k| {
-                if failure.is_some() {
-                    return false;
-                }
-                let scene = base.scene(set, |v| {
-                    time(v);
-                    v["time"]["step"] =
-                        json!({"adaptive": {"cfl": 0.2 * k, "viscous": 0.2 * k, "max": template_max * k}});
-                });
-                let slug = format!("{}-{set}-dt_k{}", base.short, slug_value(k));
-                match scene.and_then(|sc| runner.trial(base, slug, k, sc)) {
-                    Ok(m) => {
-                        particles = particles.max(m.particles);
-                        let stable = m.trial.stable;
-                        trials.push(m.trial);
-                        stable
-                    }
-                    Err(e) => {
-                        failure = Some(e);
-                        false
-                    }
-                }
-            });
-            if let Some(e) = failure {
-                return Err(e);
-            }
+            let (bracket, trials, particles) =
+                runner.bisect_trials(base, (s.dt_range[0], s.dt_range[1], s.dt_iterations), |k| {
+                    let scene = base.scene(set, |v| {
+                        time(v);
+                        v["time"]["step"] = json!({"adaptive": {"cfl": 0.2 * k, "viscous": 0.2 * k, "max": template_max * k}});
+                    });
+                    (format!("{}-{set}-dt_k{}", base.short, slug_value(k)), scene)
+                })?;
             let config = format!(
                 "{}, dx = {}, to t = {} s; Δt = k × adaptive step (α_c = α_d = 0.2 k), k bisected in [{}, {}]",
                 base.case.case,
@@ -669,35 +684,15 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
         }
         // Largest stable Reynolds number of the channel.
         {
-            let mut trials = Vec::new();
-            let mut particles = 0;
-            let mut failure = None;
-            let bracket = bisect(s.re_range[0], s.re_range[1], s.re_iterations, |re| {
-                if failure.is_some() {
-                    return false;
-                }
-                let force = 12.0 * nu * nu * re / width.powi(3);
-                let scene = channel.scene(set, |v| {
-                    channel_time(v);
-                    v["body_force"] = json!([force, 0.0]);
-                });
-                let slug = format!("channel-{set}-re{}", slug_value(re));
-                match scene.and_then(|sc| runner.trial(&channel, slug, re, sc)) {
-                    Ok(m) => {
-                        particles = particles.max(m.particles);
-                        let stable = m.trial.stable;
-                        trials.push(m.trial);
-                        stable
-                    }
-                    Err(e) => {
-                        failure = Some(e);
-                        false
-                    }
-                }
-            });
-            if let Some(e) = failure {
-                return Err(e);
-            }
+            let (bracket, trials, particles) =
+                runner.bisect_trials(&channel, (s.re_range[0], s.re_range[1], s.re_iterations), |re| {
+                    let force = 12.0 * nu * nu * re / width.powi(3);
+                    let scene = channel.scene(set, |v| {
+                        channel_time(v);
+                        v["body_force"] = json!([force, 0.0]);
+                    });
+                    (format!("channel-{set}-re{}", slug_value(re)), scene)
+                })?;
             let config = format!(
                 "poiseuille_periodic, dx = {}, to {} D²/ν; F = 12 ν² Re / D³ (ν = {nu:e} m²/s), adaptive step (α = 0.2), Re bisected in [{}, {}]",
                 crate::report::html::format_dx(channel.dx),
