@@ -25,7 +25,7 @@ use crate::error::{SceneError, SolverError};
 use crate::run::Simulation;
 use crate::scene::Scene;
 use crate::stage::StepContext;
-use crate::state::{Particles, State, Vector};
+use crate::state::{Flux, InletLink, Particles, State, Vector, WcFields};
 
 /// A simulation with its clock, steppable one stage at a time.
 #[derive(Debug)]
@@ -35,7 +35,8 @@ pub struct Stepper<const D: usize> {
     step: usize,
 }
 
-/// The per-particle arrays and the clock of a [`Stepper`] at one instant.
+/// The per-particle arrays (with the open-boundary buffers, the inlet link, the mass fluxes
+/// and the WCSPH fields) and the clock of a [`Stepper`] at one instant.
 #[derive(Debug, Clone, Default)]
 pub struct Snapshot<const D: usize> {
     particles: Particles<D>,
@@ -43,6 +44,10 @@ pub struct Snapshot<const D: usize> {
     u_old: Vec<Vector<D>>,
     div_r: Vec<f64>,
     free_surface: Vec<bool>,
+    buffer: usize,
+    flux: Flux,
+    inlet: InletLink,
+    wc: WcFields<D>,
     time: f64,
     step: usize,
 }
@@ -156,6 +161,10 @@ impl<const D: usize> Stepper<D> {
         snap.u_old.clone_from(&st.u_old);
         snap.div_r.clone_from(&st.div_r);
         snap.free_surface.clone_from(&st.free_surface);
+        snap.buffer = st.buffer;
+        snap.flux = st.flux;
+        snap.inlet.clone_from(&st.inlet);
+        snap.wc.clone_from(&st.wc);
         snap.time = self.time;
         snap.step = self.step;
     }
@@ -170,6 +179,10 @@ impl<const D: usize> Stepper<D> {
         st.u_old.clone_from(&snap.u_old);
         st.div_r.clone_from(&snap.div_r);
         st.free_surface.clone_from(&snap.free_surface);
+        st.buffer = snap.buffer;
+        st.flux = snap.flux;
+        st.inlet.clone_from(&snap.inlet);
+        st.wc.clone_from(&snap.wc);
         self.time = snap.time;
         self.step = snap.step;
     }
