@@ -64,7 +64,7 @@ pub enum Cause {
     },
     /// A particle left the region around the initial bounding box.
     #[error(
-        "particle {particle} escaped to {} m, outside the guard box {} .. {} m (the initial bounding box enlarged by 4 times its size){}",
+        "particle {particle} escaped to {} m, outside the guard box {} .. {} m (the initial bounding box enlarged by 4 times its size, or by twice the distance the fastest initial particle could have coasted){}",
         point(position), point(lo), point(hi), others_note(*others)
     )]
     Escape {
@@ -77,6 +77,26 @@ pub enum Cause {
         /// Upper corner of the guard box \[m\].
         hi: Vec<f64>,
         /// Number of other particles outside the box at the same step.
+        others: usize,
+    },
+    /// A particle moves farther than the kernel support in one step: the neighbour search
+    /// cannot follow it (a fixed step far beyond the CFL limit, or velocities blowing up).
+    #[error(
+        "particle {particle} at {} m moves at {speed:.4e} m/s: {:.4e} m in the step of {dt:.4e} s, farther than the kernel support {support:.4e} m, so its neighbours cannot be followed (lower time.step, or use an adaptive step){}",
+        point(position), speed * dt, others_note(*others)
+    )]
+    Overstep {
+        /// Particle id.
+        particle: usize,
+        /// Its position \[m\].
+        position: Vec<f64>,
+        /// Its speed \[m/s\].
+        speed: f64,
+        /// The step \[s\].
+        dt: f64,
+        /// The kernel support radius \[m\].
+        support: f64,
+        /// Number of other particles moving as far at the same step.
         others: usize,
     },
     /// A fluid particle has far more neighbours than a particle of the initial lattice:

@@ -127,7 +127,7 @@ impl<const D: usize> Stepper<D> {
 
     /// The driver's end-of-step guard (finite values, no escaped particle).
     pub fn guard(&self, ctx: &StepContext) -> Result<(), SolverError> {
-        self.sim.guard().map_err(|cause| SolverError {
+        self.sim.guard(ctx.time + ctx.dt, ctx.dt).map_err(|cause| SolverError {
             stage: "guard",
             step: ctx.step,
             time: ctx.time,

@@ -117,7 +117,9 @@ pub struct Simulation<const D: usize> {
     pub(crate) state: State<D>,
     pub(crate) stages: Vec<Box<dyn Stage<D>>>,
     probes: ProbeSet<D>,
-    bounds: (Vector<D>, Vector<D>),
+    guard_box: GuardBox<D>,
+    /// Kernel support radius \[m\]: no particle may move farther in one step.
+    support: f64,
     neighbour_band: NeighbourBand,
     last_good: LastGood<D>,
 }
@@ -303,8 +305,7 @@ impl<const D: usize> Simulation<D> {
             lo = lo.inf(x);
             hi = hi.sup(x);
         }
-        let margin = 4.0 * (hi - lo).max().max(10.0 * scene.dx);
-        let bounds = (lo.add_scalar(-margin), hi.add_scalar(margin));
+        let guard_box = GuardBox::new(scene, &particles.u, lo, hi);
         let n = particles.len();
         let state = State {
             particles,
@@ -336,7 +337,8 @@ impl<const D: usize> Simulation<D> {
             state,
             stages,
             probes: ProbeSet::new(&scene.probes, weight, scene.dx, domain),
-            bounds,
+            guard_box,
+            support,
             neighbour_band,
             last_good: LastGood::default(),
         })
@@ -414,7 +416,7 @@ impl<const D: usize> Simulation<D> {
             }
             ppe_iters += self.state.ppe.info.iterations;
             let s0 = Instant::now();
-            let guard = self.guard();
+            let guard = self.guard(t + dt, dt);
             t_guard += s0.elapsed().as_secs_f64();
             if let Err(cause) = guard {
                 error = Some(SolverError { stage: "guard", step: ctx.step, time: t, cause });
@@ -482,7 +484,14 @@ impl<const D: usize> Simulation<D> {
                 match &self.scene.scheme {
                     Scheme::Isph(opts) => {
                         if mu > 0.0 && opts.viscosity == crate::scene::ViscousIntegration::Explicit {
-                            dt = dt.min(viscous * self.state.density * h * h / mu);
+                            // The Monaghan–Cleary operator acts along r̂_ab with weight
+                            // 2(D+2) against Shao–Lo's 2 on all components: its largest
+                            // eigenvalue is (D+2)/D times larger, so its stable step smaller.
+                            let stiffness = match opts.viscous_operator {
+                                crate::scene::ViscousOperator::ShaoLo => 1.0,
+                                crate::scene::ViscousOperator::MonaghanCleary => (D as f64 + 2.0) / D as f64,
+                            };
+                            dt = dt.min(viscous * self.state.density * h * h / (mu * stiffness));
                         }
                     }
                     Scheme::Wcsph(opts) => {
@@ -518,27 +527,31 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// End-of-step checks, in this order of precedence: every position, velocity and
-    /// pressure is finite; no particle left the guard box (the initial bounding box
-    /// enlarged by four times its size); no fluid particle has more neighbours than the
+    /// pressure is finite; no particle left the [`GuardBox`] at `time` \[s\]; no particle
+    /// moves farther than the kernel support in a step of `dt` \[s\] at its speed (the
+    /// neighbour search could not follow it: a fixed step far beyond the CFL limit); no fluid particle has more neighbours than the
     /// [`NeighbourBand`] allows. The cause names the lowest particle id that failed the
     /// most severe check and how many others failed it too.
-    pub(crate) fn guard(&self) -> Result<(), Cause> {
+    pub(crate) fn guard(&self, time: f64, dt: f64) -> Result<(), Cause> {
         use rayon::prelude::*;
         let p = &self.state.particles;
-        let (lo, hi) = &self.bounds;
+        let (lo, hi) = &self.guard_box.at(time);
         let list = &self.state.neighbours;
         // Rows 0..fluid are the fluid's (dummy walls add rows after them).
         let counted = list.len() >= p.len();
         let limit = self.neighbour_band.limit;
+        let support = self.support;
         // Severity of particle a's failure (0 = none), most severe first.
         let severity = |a: usize| -> u8 {
             if !p.x[a].iter().all(|v| v.is_finite()) {
-                5
+                6
             } else if !p.u[a].iter().all(|v| v.is_finite()) {
-                4
+                5
             } else if !p.p[a].is_finite() {
-                3
+                4
             } else if (0..D).any(|k| p.x[a][k] < lo[k] || p.x[a][k] > hi[k]) {
+                3
+            } else if p.u[a].norm() * dt > support {
                 2
             } else if counted && list.of(a).len() > limit {
                 1
@@ -564,10 +577,18 @@ impl<const D: usize> Simulation<D> {
         let (particle, others) = (id as usize, n - 1);
         let vec = |v: &Vector<D>| v.iter().copied().collect::<Vec<f64>>();
         Err(match level {
-            5 => Cause::NonFinite { quantity: "position", particle, others },
-            4 => Cause::NonFinite { quantity: "velocity", particle, others },
-            3 => Cause::NonFinite { quantity: "pressure", particle, others },
-            2 => Cause::Escape { particle, position: vec(&p.x[a]), lo: vec(lo), hi: vec(hi), others },
+            6 => Cause::NonFinite { quantity: "position", particle, others },
+            5 => Cause::NonFinite { quantity: "velocity", particle, others },
+            4 => Cause::NonFinite { quantity: "pressure", particle, others },
+            3 => Cause::Escape { particle, position: vec(&p.x[a]), lo: vec(lo), hi: vec(hi), others },
+            2 => Cause::Overstep {
+                particle,
+                position: vec(&p.x[a]),
+                speed: p.u[a].norm(),
+                dt,
+                support: self.support,
+                others,
+            },
             _ => Cause::Clumping {
                 particle,
                 position: vec(&p.x[a]),
@@ -702,6 +723,37 @@ fn build<K: Kernel, const D: usize>(
     (stages, Weight { w: Box::new(move |r| kernel.w(r)), support: kernel.support })
 }
 
+/// The box a particle must stay in: the initial bounding box enlarged on every side by
+/// four times its largest size (at least 10 Δx), or, if larger, by twice the distance a
+/// particle could have coasted by time t, `2 (|u|_max,0 t + |g| t²/2)`. A free body spun
+/// fast (`rotating_square`: 70 m/s at the corners) legitimately flings fluid far beyond
+/// four times its size; leaving the box faster than that is a blow-up.
+#[derive(Debug, Clone, Copy)]
+struct GuardBox<const D: usize> {
+    lo: Vector<D>,
+    hi: Vector<D>,
+    /// Fixed margin \[m\].
+    margin: f64,
+    /// Largest initial speed \[m/s\].
+    speed: f64,
+    /// |g| \[m/s²\].
+    accel: f64,
+}
+
+impl<const D: usize> GuardBox<D> {
+    fn new(scene: &Scene, u: &[Vector<D>], lo: Vector<D>, hi: Vector<D>) -> Self {
+        let accel = scene.body_force.iter().map(|g| g * g).sum::<f64>().sqrt();
+        let speed = u.iter().map(|u| u.norm()).fold(0.0, f64::max);
+        Self { lo, hi, margin: 4.0 * (hi - lo).max().max(10.0 * scene.dx), speed, accel }
+    }
+
+    /// The box's corners at time `t` \[s\].
+    fn at(&self, t: f64) -> (Vector<D>, Vector<D>) {
+        let m = self.margin.max(2.0 * (self.speed * t + 0.5 * self.accel * t * t));
+        (self.lo.add_scalar(-m), self.hi.add_scalar(m))
+    }
+}
+
 #[cfg(test)]
 mod guard_tests {
     use super::*;
@@ -734,14 +786,14 @@ mod guard_tests {
         let mut sim = small_drop();
         let ctx = StepContext { step: 1, time: 0.0, dt: 1e-5 };
         search_neighbours(&mut sim, &ctx).expect("neighbour search");
-        assert_eq!(sim.guard(), Ok(()), "the initial lattice is within the band");
+        assert_eq!(sim.guard(0.0, 0.0), Ok(()), "the initial lattice is within the band");
         // Squeeze the drop to a third of its size: every interior particle now has about
         // 9 × 28 neighbours.
         for x in &mut sim.state.particles.x {
             *x /= 3.0;
         }
         search_neighbours(&mut sim, &ctx).expect("neighbour search");
-        let cause = sim.guard().expect_err("clumping must trip the guard");
+        let cause = sim.guard(0.0, 0.0).expect_err("clumping must trip the guard");
         let Cause::Clumping { count, limit, bulk, others, .. } = &cause else { panic!("{cause}") };
         assert!(count > limit && *limit == 112 && *bulk == 28 && *others > 10, "{cause}");
         let msg = cause.to_string();
@@ -759,14 +811,14 @@ mod guard_tests {
         sim.state.particles.x[a][0] = 1e6;
         sim.state.particles.x[b][1] = -1e6;
         sim.state.particles.p[c] = f64::NAN;
-        match sim.guard() {
+        match sim.guard(0.0, 0.0) {
             Err(Cause::NonFinite { quantity: "pressure", particle, others: 0 }) => {
                 assert_eq!(particle, n - 1)
             }
             other => panic!("{other:?}"),
         }
         sim.state.particles.p[c] = 0.0;
-        let cause = sim.guard().expect_err("escape");
+        let cause = sim.guard(0.0, 0.0).expect_err("escape");
         assert!(matches!(cause, Cause::Escape { particle: 3, others: 1, .. }), "{cause}");
         let msg = cause.to_string();
         assert!(

@@ -21,6 +21,7 @@ fn a_time_step_far_beyond_the_cfl_limit_diverges_with_a_named_cause() {
         matches!(
             err.cause,
             Cause::Escape { .. }
+                | Cause::Overstep { .. }
                 | Cause::NonFinite { .. }
                 | Cause::Clumping { .. }
                 | Cause::PpeNoConvergence { .. }

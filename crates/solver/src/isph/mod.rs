@@ -19,7 +19,7 @@ pub mod shifting;
 use crate::kernel::{Kernel, Scaled};
 use crate::ppe::PpeSolve;
 use crate::scene::{IsphOptions, Scene, Shifting as ShiftSpec};
-use crate::scene::{ViscousIntegration, WallModel};
+use crate::scene::{ViscousIntegration, ViscousOperator, WallModel};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::neighbours::{Neighbours, Rows};
@@ -83,7 +83,10 @@ pub fn build_stages<K: Kernel, const D: usize>(
     let nu = scene.fluid.viscosity / scene.fluid.density;
     let implicit = opts.viscosity == ViscousIntegration::Implicit;
     if nu > 0.0 && !implicit {
-        stages.push(Box::new(predictor::Viscosity { nu }));
+        match opts.viscous_operator {
+            ViscousOperator::ShaoLo => stages.push(Box::new(predictor::Viscosity { nu })),
+            ViscousOperator::MonaghanCleary => stages.push(Box::new(predictor::CentralViscosity { nu })),
+        }
     }
     if g.norm_squared() > 0.0 {
         stages.push(Box::new(predictor::BodyForce { g }));

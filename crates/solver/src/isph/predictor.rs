@@ -60,6 +60,38 @@ impl<const D: usize> Stage<D> for Viscosity {
     }
 }
 
+/// Qiu eq. 4 viscous part with the Monaghan–Cleary operator
+/// ([`crate::scene::ViscousOperator::MonaghanCleary`]):
+/// `u*_a = u^n_a + Δt 2(D+2) ν Σ_b V_b (u_ab·r_ab) f_ab r_ab/(r² + 0.01 h²)`, with
+/// `∇_aW_ab = f_ab r_ab`, at the advected positions `r*` with the velocities `u^n`.
+#[derive(Debug)]
+pub struct CentralViscosity {
+    /// Kinematic viscosity ν = μ/ρ \[m²/s\].
+    pub nu: f64,
+}
+
+impl<const D: usize> Stage<D> for CentralViscosity {
+    fn name(&self) -> &'static str {
+        "viscosity"
+    }
+
+    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+        let eta2 = 0.01 * s.h * s.h;
+        let c = ctx.dt * self.nu * 2.0 * (D as f64 + 2.0) * s.volume;
+        let (list, pairs, u_old) = (&s.neighbours, &s.pairs, &s.u_old);
+        s.particles.u[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
+            let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
+            let mut acc = Vector::<D>::zeros();
+            for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+                let u_ab = u_old[a] - u_old[b as usize];
+                acc += p.r_ab * (u_ab.dot(&p.r_ab) * p.f / (p.r2 + eta2));
+            }
+            *u = u_old[a] + acc * c;
+        });
+        Ok(())
+    }
+}
+
 /// Qiu eq. 4 body-force part: `u* += Δt g`.
 #[derive(Debug)]
 pub struct BodyForce<const D: usize> {
