@@ -79,10 +79,11 @@ pub enum Cause {
         /// Number of other particles outside the box at the same step.
         others: usize,
     },
-    /// A particle moves farther than the kernel support in one step: the neighbour search
-    /// cannot follow it (a fixed step far beyond the CFL limit, or velocities blowing up).
+    /// Two fluid neighbours move farther than the kernel support relative to each other in one
+    /// step: the neighbour lists cannot follow them (a fixed step far beyond the CFL limit,
+    /// or velocities blowing up).
     #[error(
-        "particle {particle} at {} m moves at {speed:.4e} m/s: {:.4e} m in the step of {dt:.4e} s, farther than the kernel support {support:.4e} m, so its neighbours cannot be followed (lower time.step, or use an adaptive step){}",
+        "particle {particle} at {} m and its neighbour {neighbour} move at {speed:.4e} m/s relative to each other: {:.4e} m in the step of {dt:.4e} s, farther than the kernel support {support:.4e} m, so the neighbour lists cannot follow them (lower time.step, or use an adaptive step){}",
         point(position), speed * dt, others_note(*others)
     )]
     Overstep {
@@ -90,13 +91,15 @@ pub enum Cause {
         particle: usize,
         /// Its position \[m\].
         position: Vec<f64>,
-        /// Its speed \[m/s\].
+        /// Id of the fluid neighbour it moves fastest against.
+        neighbour: usize,
+        /// Their relative speed \[m/s\].
         speed: f64,
         /// The step \[s\].
         dt: f64,
         /// The kernel support radius \[m\].
         support: f64,
-        /// Number of other particles moving as far at the same step.
+        /// Number of other particles with such a neighbour at the same step.
         others: usize,
     },
     /// A fluid particle has far more neighbours than a particle of the initial lattice:

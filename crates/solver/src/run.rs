@@ -527,9 +527,10 @@ impl<const D: usize> Simulation<D> {
     }
 
     /// End-of-step checks, in this order of precedence: every position, velocity and
-    /// pressure is finite; no particle left the [`GuardBox`] at `time` \[s\]; no particle
-    /// moves farther than the kernel support in a step of `dt` \[s\] at its speed (the
-    /// neighbour search could not follow it: a fixed step far beyond the CFL limit); no fluid particle has more neighbours than the
+    /// pressure is finite; no particle left the [`GuardBox`] at `time` \[s\]; no two fluid
+    /// neighbours move farther than the kernel support relative to each other in a step of
+    /// `dt` \[s\] (the neighbour lists could not follow them: a fixed step far beyond the
+    /// CFL limit; Galilean invariant, so a fast but rigid motion passes); no fluid particle has more neighbours than the
     /// [`NeighbourBand`] allows. The cause names the lowest particle id that failed the
     /// most severe check and how many others failed it too.
     pub(crate) fn guard(&self, time: f64, dt: f64) -> Result<(), Cause> {
@@ -551,7 +552,12 @@ impl<const D: usize> Simulation<D> {
                 4
             } else if (0..D).any(|k| p.x[a][k] < lo[k] || p.x[a][k] > hi[k]) {
                 3
-            } else if p.u[a].norm() * dt > support {
+            } else if a < list.len()
+                && list.of(a).iter().any(|&b| {
+                    (b as usize) < p.len()
+                        && (p.u[a] - p.u[b as usize]).norm_squared() * dt * dt > support * support
+                })
+            {
                 2
             } else if counted && list.of(a).len() > limit {
                 1
@@ -581,14 +587,20 @@ impl<const D: usize> Simulation<D> {
             5 => Cause::NonFinite { quantity: "velocity", particle, others },
             4 => Cause::NonFinite { quantity: "pressure", particle, others },
             3 => Cause::Escape { particle, position: vec(&p.x[a]), lo: vec(lo), hi: vec(hi), others },
-            2 => Cause::Overstep {
-                particle,
-                position: vec(&p.x[a]),
-                speed: p.u[a].norm(),
-                dt,
-                support: self.support,
-                others,
-            },
+            2 => {
+                let speed = |b: &u32| (p.u[a] - p.u[*b as usize]).norm();
+                let fluid = list.of(a).iter().copied().filter(|&b| (b as usize) < p.len());
+                let b = fluid.max_by(|b, c| speed(b).total_cmp(&speed(c))).unwrap_or(0);
+                Cause::Overstep {
+                    particle,
+                    position: vec(&p.x[a]),
+                    neighbour: p.id[b as usize] as usize,
+                    speed: speed(&b),
+                    dt,
+                    support,
+                    others,
+                }
+            }
             _ => Cause::Clumping {
                 particle,
                 position: vec(&p.x[a]),

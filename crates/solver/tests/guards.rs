@@ -74,3 +74,44 @@ fn a_fractional_last_step_is_shorter_never_longer() {
     assert_eq!(report.summary.steps, 3);
     assert!((report.summary.t_end - 5e-5).abs() < 1e-18);
 }
+
+#[test]
+fn a_fast_rigid_translation_is_not_an_overstep() {
+    // 100 m/s for 2 ms a step: each particle moves 0.2 m, beyond the 0.12 m support, but
+    // all together; the overstep guard looks at neighbours' relative motion only.
+    let scene = common::drop_scene(|v| {
+        v["dx"] = json!(0.04);
+        v["bodies"][0]["velocity"] =
+            json!({"affine": {"gradient": [[0.0, 0.0], [0.0, 0.0]], "offset": [100.0, 0.0]}});
+        v["bodies"][0]["pressure"] = json!("zero");
+        v["time"] = json!({"end": 0.01, "step": {"fixed": 2e-3}});
+    });
+    let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
+    assert!(report.error.is_none(), "{:?}", report.error);
+    assert_eq!(report.summary.steps, 5);
+}
+
+#[test]
+fn an_overstep_next_to_mirror_walls_is_a_typed_error() {
+    // Mirror particles are neighbours too; the guard compares fluid neighbours only.
+    let v = json!({
+        "name": "channel", "dimension": 2, "dx": 0.01,
+        "kernel": { "kind": "cubic_spline", "h_over_dx": 1.5 },
+        "fluid": { "density": 1000.0, "viscosity": 1e-3 },
+        "body_force": [1.0, 0.0],
+        "bodies": [ { "role": "fluid", "shape": { "rectangle": { "min": [0.0, 0.0], "max": [0.1, 0.2] } } } ],
+        "boundaries": {
+            "periodic": [ { "axis": 0, "min": 0.0, "max": 0.1 } ],
+            "walls": [ { "axis": 1, "position": 0.0, "fluid_side": "above" },
+                       { "axis": 1, "position": 0.2, "fluid_side": "below" } ]
+        },
+        "scheme": { "isph": { "ppe": { "solver": "bicgstab", "tolerance": 1e-6, "max_iterations": 2000 },
+                              "free_surface_threshold": 1.5 } },
+        "time": { "end": 50.0, "step": { "fixed": 10.0 } },
+        "probes": [ { "kinetic_energy": {} } ]
+    });
+    let scene = meniscus::Scene::from_json(&v.to_string()).expect("valid scene");
+    let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
+    let err = report.error.as_ref().expect("the run must diverge");
+    assert!(matches!(err.cause, Cause::Overstep { .. }), "{err}");
+}
