@@ -1,10 +1,10 @@
 //! Shared fixtures for the criterion benches: the scenes benched, and a prepared state on
 //! which one stage can be re-run with representative work.
 //!
-//! Scenes: [`scenes`] lists every benched scene. Today that is the DESIGN.md elliptical
-//! drop at Δx = 0.04, 0.02, 0.01 ([`elliptical_drop`]); the periodic Poiseuille channel
-//! joins as one more function returning its `BenchScene`s, appended in [`scenes`], once
-//! the solver runs wall bodies.
+//! Scenes: [`scenes`] lists every benched scene: the DESIGN.md elliptical drop at
+//! Δx = 0.04, 0.02, 0.01 ([`elliptical_drop`]) and the periodic Poiseuille channel at D/36
+//! ([`periodic_channel`]: mirror walls, one periodic axis, so its steps include the
+//! `walls` and `mirror_velocity` stages and the minimum-image displacements).
 //!
 //! Stage benches ([`StageBench`]): the scene is stepped [`WARM_STEPS`] whole steps (so the
 //! PPE warm start, shifting and the particle order are those of a running simulation), the
@@ -60,9 +60,30 @@ pub fn elliptical_drop() -> Vec<BenchScene> {
         .collect()
 }
 
-/// Every benched scene (add the periodic Poiseuille channel here when it exists).
+/// The periodic Poiseuille channel of `validation/poiseuille_periodic.json` as its
+/// template stands (Re = U D/ν = 40, D = 0.2 m, Δx = D/36: 648 fluid particles, mirror
+/// walls at y = 0 and D, periodic in x over D/2, Xu shifting, BiCGSTAB 1e-3, adaptive Δt).
+pub fn periodic_channel() -> Vec<BenchScene> {
+    let case: serde_json::Value =
+        serde_json::from_str(include_str!("../../validation/poiseuille_periodic.json"))
+            .expect("the committed case file is JSON");
+    let scene = Scene::from_json(&case["scene"].to_string()).expect("the committed channel scene is valid");
+    vec![BenchScene { label: "channel_d36".into(), scene }]
+}
+
+/// Every benched scene: the drops, then the channel.
 pub fn scenes() -> Vec<BenchScene> {
-    elliptical_drop()
+    let mut s = elliptical_drop();
+    s.extend(periodic_channel());
+    s
+}
+
+/// `scene` with the backward-Euler viscous predictor (`viscosity: implicit`).
+pub fn with_implicit_viscosity(scene: &Scene) -> Scene {
+    let mut s = scene.clone();
+    let Scheme::Isph(opts) = &mut s.scheme else { return s };
+    opts.viscosity = meniscus::scene::ViscousIntegration::Implicit;
+    s
 }
 
 /// `scene` with its PPE solved by `solver` (Krylov tolerance 1e-3, the paper's).
@@ -217,6 +238,20 @@ mod tests {
     }
 
     #[test]
+    fn channel_stages_are_benched() {
+        let ch = &periodic_channel()[0].scene;
+        let mut walls = StageBench::new(ch, "walls", true).unwrap();
+        assert!(walls.time(2) > Duration::ZERO);
+        assert_eq!(walls.size().particles, 648);
+        let st = walls.stepper.state();
+        assert!(st.particles.total() > st.particles.len(), "mirror particles added");
+        let mut implicit = StageBench::new(&with_implicit_viscosity(ch), "viscosity_implicit", true).unwrap();
+        assert!(implicit.time(2) > Duration::ZERO);
+        let mut step = StepBench::new(ch);
+        assert!(step.time(1) > Duration::ZERO);
+    }
+
+    #[test]
     fn step_bench_restarts_from_the_saved_state() {
         let mut b = StepBench::new(&drop_scene(0.05, 10));
         assert!(b.time(2) > Duration::ZERO);
@@ -226,8 +261,9 @@ mod tests {
     #[test]
     fn every_scene_is_labelled_and_valid() {
         let s = scenes();
-        assert_eq!(s.len(), 3);
+        assert_eq!(s.len(), 4);
         assert_eq!(s[1].label, "drop_dx0.02");
+        assert_eq!(s[3].label, "channel_d36");
         for b in &s {
             meniscus::scene::validate(&b.scene).unwrap();
         }

@@ -1,5 +1,6 @@
 //! `cargo xtask bench [--quick|--full] [--out DIR] [--threads N]`: the work-precision
-//! study of the elliptical drop into `reports/work_precision/`.
+//! study of the elliptical drop and the periodic Poiseuille channel into
+//! `reports/work_precision/`.
 
 use anyhow::Context;
 use meniscus_harness::work_precision::{self, Options};
@@ -9,10 +10,10 @@ use std::process::ExitCode;
 /// Options of `cargo xtask bench`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Δx 0.04 and 0.02 only, few option sets (about 2 minutes).
+    /// Drop Δx 0.04 and 0.02 only, few option sets; the channel at D/36 only (about 2 minutes).
     #[arg(long, conflicts_with = "full")]
     quick: bool,
-    /// Adds Δx = 0.005 (the full range for the cost-per-step exponent).
+    /// Adds drop Δx = 0.005 (the full range for the cost-per-step exponent) and channel Δx = 0.0025.
     #[arg(long)]
     full: bool,
     /// Output directory [default: <workspace>/reports/work_precision].
@@ -42,12 +43,20 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let study = work_precision::run(&opts).context("the work-precision study could not run")?;
     let diverged = study.runs.iter().filter(|r| !r.ok()).count();
     eprintln!(
-        "{} runs ({diverged} diverged) in {:.0} s, tier {}, {} threads",
+        "drop: {} runs ({diverged} diverged); both studies in {:.0} s, tier {}, {} threads",
         study.runs.len(),
         study.elapsed_s,
         study.tier,
         study.threads
     );
+    if let Some(c) = &study.channel {
+        let diverged = c.runs.iter().filter(|r| !r.ok()).count();
+        eprintln!(
+            "channel: {} runs ({diverged} diverged), Pareto front: {}",
+            c.runs.len(),
+            c.pareto.join(", ")
+        );
+    }
     for t in &study.targets {
         let value = t.value.map_or("n/a".to_string(), |v| format!("{v:.3}"));
         let op = if t.kind == "max" { "<=" } else { ">=" };

@@ -1,9 +1,11 @@
 //! Criterion benches of the solver's hot stages and of whole steps, on every scene of
-//! `meniscus_benches::scenes()` (the elliptical drop at Δx = 0.04, 0.02, 0.01).
+//! `meniscus_benches::scenes()` (the elliptical drop at Δx = 0.04, 0.02, 0.01 and the
+//! periodic channel at D/36).
 //!
 //! Throughput: the per-pair passes (`neighbour_search`, `neighbours`, `free_surface`,
 //! `viscosity`, `ppe_assemble`, `correction`, `shifting`) report neighbour pairs per
-//! second; the PPE solves and the whole step report particles per second. The particle and
+//! second; the PPE solves, the channel's `walls`, the implicit viscous predictor and the
+//! whole step report particles per second. The particle and
 //! pair counts of every scene are printed first, to convert one into the other. How each
 //! bench re-runs a stage with a step's worth of work is documented in `meniscus_benches`.
 //!
@@ -17,6 +19,7 @@ mod predictor;
 mod search;
 mod shifting;
 mod step;
+mod walls;
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use meniscus_benches::{StageBench, scenes};
@@ -89,6 +92,7 @@ criterion_group! {
     name = benches;
     config = config();
     targets = sizes, search::neighbour_search, search::neighbours_stage, free_surface::bench,
-        predictor::bench, ppe::assemble, ppe::solve, correction::bench, shifting::bench, step::bench
+        predictor::bench, ppe::assemble, ppe::solve, correction::bench, shifting::bench, walls::walls,
+        walls::implicit_viscosity, step::bench
 }
 criterion_main!(benches);

@@ -278,14 +278,83 @@ impl<const D: usize> CellSearch<D> {
         self.chunk_rows = chunk_rows;
     }
 
-    /// Calls `f` with every particle in the 3^D cells around `p` (each particle once).
+    /// Calls `f` with every particle in the 3^D cells around `p` (each particle once), in
+    /// the order of [`Self::visit_cells`].
+    ///
+    /// Axis 0 varies fastest in the cell id, so the (up to) three cells of one row around
+    /// `p` are consecutive ids and their particles one contiguous run of `sorted`: one
+    /// range per row of cells (3^(D−1) ranges) instead of one per cell. A row that wraps
+    /// around a periodic axis 0 is not contiguous and goes cell by cell.
     #[inline]
     fn visit_candidates(&self, p: &SVector<f64, D>, mut f: impl FnMut(u32)) {
+        let base = self.cell_index(p);
+        let d0 = self.dims[0] as isize;
+        let (lo0, hi0) = if self.domain.periodic[0].is_some() {
+            if d0 < 3 || base[0] < 1 || base[0] + 1 >= d0 {
+                return self.visit_cells(&base, f);
+            }
+            (base[0] - 1, base[0] + 1)
+        } else {
+            ((base[0] - 1).max(0), (base[0] + 1).min(d0 - 1))
+        };
+        let mut off = [-1isize; D];
+        'rows: loop {
+            let mut row = 0usize;
+            let mut valid = true;
+            for k in (1..D).rev() {
+                let mut i = base[k] + off[k];
+                let dk = self.dims[k] as isize;
+                if self.domain.periodic[k].is_some() {
+                    if dk < 3 && off[k] != 0 && (dk == 1 || off[k] == 1) {
+                        valid = false;
+                        break;
+                    }
+                    i = i.rem_euclid(dk);
+                } else if i < 0 || i >= dk {
+                    valid = false;
+                    break;
+                }
+                row = row * self.dims[k] + i as usize;
+            }
+            if valid {
+                let first = row * self.dims[0];
+                let (s, e) = (
+                    self.cell_start[first + lo0 as usize] as usize,
+                    self.cell_start[first + hi0 as usize + 1] as usize,
+                );
+                for &j in &self.sorted[s..e] {
+                    f(j);
+                }
+            }
+            let mut k = 1;
+            loop {
+                if k >= D {
+                    break 'rows;
+                }
+                off[k] += 1;
+                if off[k] <= 1 {
+                    break;
+                }
+                off[k] = -1;
+                k += 1;
+            }
+        }
+    }
+
+    /// The cell holding `p`, per axis (clamped into the grid).
+    #[inline]
+    fn cell_index(&self, p: &SVector<f64, D>) -> [isize; D] {
         let mut base = [0isize; D];
         for k in 0..D {
             base[k] = (((p[k] - self.origin[k]) / self.cell_size[k]).floor().max(0.0) as isize)
                 .min(self.dims[k] as isize - 1);
         }
+        base
+    }
+
+    /// Calls `f` with every particle in the 3^D cells around the cell `base`, cell by cell
+    /// (axis 0 fastest; each cell once, also when a periodic axis has fewer than 3 cells).
+    fn visit_cells(&self, base: &[isize; D], mut f: impl FnMut(u32)) {
         let mut off = [-1isize; D];
         'cells: loop {
             let mut id = 0usize;
@@ -376,6 +445,34 @@ mod tests {
         check::<3>(500, 0.2, per3, 8);
         // Fewer than three cells per period.
         check::<2>(200, 0.45, per, 9);
+    }
+
+    /// The row ranges give each list in exactly the cell-by-cell order (so the sums over
+    /// neighbours, and the results, are bit for bit those of the cell-by-cell visit).
+    #[test]
+    fn row_ranges_keep_the_cell_by_cell_order() {
+        fn same_order<const D: usize>(dom: Domain<D>, r: f64, seed: u64) {
+            let mut rng = ChaCha8Rng::seed_from_u64(seed);
+            let x: Vec<SVector<f64, D>> =
+                (0..600).map(|_| SVector::from_fn(|_, _| rng.random_range(0.0..1.0))).collect();
+            let mut search = CellSearch::new(r, dom);
+            let mut list = NeighbourList::default();
+            search.build(&x, &mut list);
+            for (a, xa) in x.iter().enumerate() {
+                let mut want = Vec::new();
+                search.visit_cells(&search.cell_index(xa), |b| {
+                    if b as usize != a && dom.displacement(xa, &x[b as usize]).norm_squared() < r * r {
+                        want.push(b);
+                    }
+                });
+                assert_eq!(list.of(a), &want[..], "particle {a}");
+            }
+        }
+        same_order::<2>(Domain::default(), 0.07, 1);
+        same_order::<2>(Domain { periodic: [Some((0.0, 1.0)), None] }, 0.09, 2);
+        same_order::<2>(Domain { periodic: [None, Some((0.0, 1.0))] }, 0.09, 3);
+        same_order::<2>(Domain { periodic: [Some((0.0, 1.0)), None] }, 0.45, 4);
+        same_order::<3>(Domain { periodic: [Some((0.0, 1.0)), None, Some((0.0, 1.0))] }, 0.2, 5);
     }
 
     #[test]

@@ -1,4 +1,5 @@
-//! `cargo xtask bench`: the work-precision study of the elliptical drop.
+//! `cargo xtask bench`: the work-precision study of the elliptical drop and the periodic
+//! Poiseuille channel ([`channel`]).
 //!
 //! Every run of a pruned design over spacing × PPE solver and tolerance × gradient form ×
 //! divergence form × shifting × time-step rule ([`design`]) goes through the solver
@@ -10,8 +11,11 @@
 //! speed-ups and evaluates the performance issue's targets ([`targets`]), draws the figures
 //! ([`plots`]) and writes `results.json`, one SVG per figure and `index.html` into the
 //! output directory, atomically (`results.json` is also rewritten, marked incomplete,
-//! after every run, so an interrupted study keeps what it measured).
+//! after every run, so an interrupted study keeps what it measured). The channel's runs
+//! follow the drop's and are recorded in the `channel` field of `results.json`, with their
+//! own Pareto front and figure; the targets are the drop's.
 
+pub mod channel;
 pub mod design;
 pub mod page;
 pub mod pareto;
@@ -24,6 +28,7 @@ use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::metrics;
 use crate::provenance::Provenance;
+use channel::ChannelStudy;
 use design::{Design, Planned, Ppe, Variant};
 use record::{Machine, RunRow, Study};
 use std::path::{Path, PathBuf};
@@ -70,11 +75,44 @@ fn loadavg() -> Option<String> {
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
 }
 
+/// What running one scene gave: the solver's report, or the message of a panic inside it;
+/// and the process CPU time over the run.
+pub struct Outcome {
+    /// The report (which may carry a divergence), or the panic message.
+    pub report: std::result::Result<meniscus::RunReport, String>,
+    /// CPU time of the process over the run \[s\] (`None` off Linux).
+    pub cpu_s: Option<f64>,
+}
+
+/// Runs `scene` on `pool`; a panic inside the solver is caught and becomes the outcome.
+fn run_scene(
+    scene: &meniscus::Scene,
+    pool: &rayon::ThreadPool,
+) -> std::result::Result<Outcome, meniscus::SceneError> {
+    let cpu0 = process_cpu_s();
+    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        pool.install(|| meniscus::run(scene, &mut meniscus::Quiet))
+    }));
+    let cpu_s = process_cpu_s().zip(cpu0).map(|(b, a)| b - a);
+    let report = match outcome {
+        Ok(Ok(report)) => Ok(report),
+        Ok(Err(source)) => return Err(source),
+        Err(panic) => Err(panic
+            .downcast_ref::<String>()
+            .cloned()
+            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
+            .unwrap_or_else(|| "unknown".into())),
+    };
+    Ok(Outcome { report, cpu_s })
+}
+
 /// Runs the study and writes its directory; missed targets are results, not errors.
 pub fn run(opts: &Options) -> Result<Study> {
     let case = Case::load(&opts.validation_dir.join(format!("{CASE}.json")))?;
+    let channel_case = Case::load(&opts.validation_dir.join(format!("{}.json", channel::CASE)))?;
     let threads = opts.threads.max(1);
     let design = Design::for_tier(opts.tier, threads);
+    let (channel_runs, channel_design) = channel::design(opts.tier, threads);
     let mut provenance = Provenance::collect(&opts.workspace);
     provenance.threads = threads;
     let mut study = Study {
@@ -93,6 +131,7 @@ pub fn run(opts: &Options) -> Result<Study> {
         cost_fits: Vec::new(),
         speedups: Vec::new(),
         targets: Vec::new(),
+        channel: Some(ChannelStudy::new(channel_design)),
     };
     let mut pools = Vec::new();
     for &k in &design.thread_counts {
@@ -103,24 +142,44 @@ pub fn run(opts: &Options) -> Result<Study> {
         pools.push((k, pool));
     }
     let start = Instant::now();
-    let total = design.runs.len();
-    for (i, planned) in design.runs.iter().enumerate() {
-        let pool = &pools.iter().find(|(k, _)| *k == planned.threads).expect("a pool per thread count").1;
-        let row = execute(&case, planned, pool)?;
+    let total = design.runs.len() + channel_runs.len();
+    let pool_of =
+        |threads: usize| &pools.iter().find(|(k, _)| *k == threads).expect("a pool per thread count").1;
+    let progress = |i: usize, id: &str, wall_s: f64, cpu_s: Option<f64>, error: String, status: &str| {
         if opts.progress {
-            let done = start.elapsed().as_secs_f64();
             eprintln!(
-                "[{:>3}/{total}] {:<52} {:>8.2} s (CPU/wall {:>4})  b err {:>9}  {}  ({:.0} s elapsed)",
+                "[{:>3}/{total}] {:<52} {:>8.2} s (CPU/wall {:>4})  {error}  {status}  ({:.0} s elapsed)",
                 i + 1,
-                row.id,
-                row.wall_s,
-                row.cpu_s.map_or("—".into(), |c| format!("{:.2}", c / row.wall_s.max(1e-12))),
-                row.b_err.map_or("—".into(), |e| format!("{:.3} %", 100.0 * e)),
-                if row.ok() { "ok" } else { &row.status },
-                done
+                id,
+                wall_s,
+                cpu_s.map_or("—".into(), |c| format!("{:.2}", c / wall_s.max(1e-12))),
+                start.elapsed().as_secs_f64()
             );
         }
+    };
+    let pct = |e: Option<f64>| e.map_or("—".into(), |e| format!("{:.3} %", 100.0 * e));
+    for (i, planned) in design.runs.iter().enumerate() {
+        let row = execute(&case, planned, pool_of(planned.threads))?;
+        let status = if row.ok() { "ok" } else { &row.status };
+        progress(i, &row.id, row.wall_s, row.cpu_s, format!("b err {:>9}", pct(row.b_err)), status);
         study.runs.push(row);
+        study.elapsed_s = start.elapsed().as_secs_f64();
+        io::write_json(&opts.out.join("results.json"), &study)?;
+    }
+    for (i, planned) in channel_runs.iter().enumerate() {
+        let scene = channel::scene(&channel_case, &planned.variant, planned.dx)?;
+        let outcome = run_scene(&scene, pool_of(planned.threads)).map_err(|source| HarnessError::Scene {
+            case: channel_case.case.clone(),
+            run: planned.id(),
+            source,
+        })?;
+        let row = channel::row(&channel_case, planned, &scene, outcome)?;
+        let status = if row.ok() { "ok" } else { &row.status };
+        let error = format!("profile err {:>9}", pct(row.error));
+        progress(design.runs.len() + i, &row.id, row.wall_s, row.cpu_s, error, status);
+        if let Some(c) = &mut study.channel {
+            c.runs.push(row);
+        }
         study.elapsed_s = start.elapsed().as_secs_f64();
         io::write_json(&opts.out.join("results.json"), &study)?;
     }
@@ -143,6 +202,9 @@ pub fn derive(study: &mut Study, tier: Tier) {
     study.cost_fits = targets::cost_fits(&study.runs, study.threads);
     study.speedups = targets::speedups(&study.runs, study.threads);
     study.targets = targets::evaluate(&study.runs, study.threads, finest);
+    if let Some(c) = &mut study.channel {
+        c.derive();
+    }
 }
 
 /// Runs one planned point on `pool`; a divergence (or a panic inside the solver) becomes
@@ -150,13 +212,13 @@ pub fn derive(study: &mut Study, tier: Tier) {
 fn execute(case: &Case, planned: &Planned, pool: &rayon::ThreadPool) -> Result<RunRow> {
     let scene = design::scene(case, &planned.variant, planned.dx)?;
     let id = planned.id();
-    let cpu0 = process_cpu_s();
-    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        pool.install(|| meniscus::run(&scene, &mut meniscus::Quiet))
-    }));
-    let cpu_s = process_cpu_s().zip(cpu0).map(|(b, a)| b - a);
+    let outcome = run_scene(&scene, pool).map_err(|source| HarnessError::Scene {
+        case: case.case.clone(),
+        run: id.clone(),
+        source,
+    })?;
     let mut row = RunRow {
-        id: id.clone(),
+        id,
         dx: planned.dx,
         variant: planned.variant,
         preset: planned.variant.preset().map(str::to_string),
@@ -166,7 +228,7 @@ fn execute(case: &Case, planned: &Planned, pool: &rayon::ThreadPool) -> Result<R
         steps: 0,
         t_end: 0.0,
         wall_s: 0.0,
-        cpu_s,
+        cpu_s: outcome.cpu_s,
         stages: Default::default(),
         ppe_iterations_mean: 0.0,
         b_err: None,
@@ -174,15 +236,9 @@ fn execute(case: &Case, planned: &Planned, pool: &rayon::ThreadPool) -> Result<R
         a_err: None,
         status: "ok".into(),
     };
-    let report = match outcome {
-        Ok(Ok(report)) => report,
-        Ok(Err(source)) => return Err(HarnessError::Scene { case: case.case.clone(), run: id, source }),
-        Err(panic) => {
-            let msg = panic
-                .downcast_ref::<String>()
-                .cloned()
-                .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                .unwrap_or_else(|| "unknown".into());
+    let report = match outcome.report {
+        Ok(report) => report,
+        Err(msg) => {
             row.status = format!("diverged: the solver panicked: {msg}");
             return Ok(row);
         }
@@ -263,6 +319,17 @@ pub fn figures(study: &Study) -> Result<Vec<page::Figure>> {
             caption: "Wall time per step against particle count with the least-squares power law (log-log) of each preset; hollow markers: one thread.".into(),
         },
     ];
+    if let Some(c) = study.channel.as_ref().filter(|c| !c.runs.is_empty()) {
+        let rows: Vec<&channel::ChannelRow> = c.runs.iter().collect();
+        out.push(page::Figure {
+            file: "channel_work_precision".into(),
+            svg: plots::channel_work_precision("channel_work_precision", &rows, &c.pareto)?,
+            caption: format!(
+                "Periodic channel (Re = 4, to τ = νt/D² = 1): wall time against the steady profile error, every finished run with {} threads; the black line joins the Pareto front.",
+                study.threads
+            ),
+        });
+    }
     if !study.speedups.is_empty() {
         out.push(page::Figure {
             file: "speedup".into(),
@@ -309,6 +376,7 @@ mod tests {
             cost_fits: vec![],
             speedups: vec![],
             targets: vec![],
+            channel: Some(ChannelStudy::new("test".into())),
         };
         // A short drop at a coarse spacing: end time cut to 10 steps.
         let mut short = case.clone();
@@ -323,19 +391,40 @@ mod tests {
             assert!(row.cpu_s.is_some_and(|c| c >= 0.0));
             study.runs.push(row);
         }
+        // The channel with implicit viscosity at D/36 to τ = 1 (about 670 steps).
+        let ch_case = Case::load(&root.join("validation/poiseuille_periodic.json")).unwrap();
+        let planned = channel::ChannelPlanned {
+            dx: channel::D36,
+            variant: channel::ChannelVariant::IMPLICIT,
+            threads: 1,
+        };
+        let scene = channel::scene(&ch_case, &planned.variant, planned.dx).unwrap();
+        let row = channel::row(&ch_case, &planned, &scene, run_scene(&scene, &pool).unwrap()).unwrap();
+        assert!(row.ok(), "{}", row.status);
+        assert_eq!((row.particles, row.preset.as_deref()), (648, Some("re4_implicit")));
+        assert!(row.error.is_some_and(|e| e < 0.05), "{:?}", row.error);
+        assert!(row.stages.contains_key("viscosity_implicit"));
+        study.channel.as_mut().unwrap().runs.push(row);
         derive(&mut study, Tier::Quick);
         assert!(!study.pareto.is_empty());
+        assert_eq!(study.channel.as_ref().unwrap().pareto.len(), 1);
         assert_eq!(study.targets.len(), 6);
         let dir = Scratch::new("work-precision");
         write(dir.path(), &study).unwrap();
         let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
         assert!(html.contains("Targets") && html.contains("<svg"));
-        for f in ["work_precision", "stages", "cost_scaling"] {
+        assert!(html.contains("Periodic channel") && html.contains("re4_implicit"));
+        for f in ["work_precision", "stages", "cost_scaling", "channel_work_precision"] {
             let svg = std::fs::read_to_string(dir.path().join(format!("{f}.svg"))).unwrap();
             assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "{f}");
         }
         let back: Study = io::read_json(&dir.path().join("results.json")).unwrap();
         assert_eq!(back.runs.len(), 3);
         assert_eq!(back.runs[0].variant, Variant::PAPER);
+        assert_eq!(back.channel, study.channel);
+        // A file written before the channel study existed still reads.
+        let mut old = serde_json::to_value(&study).unwrap();
+        old.as_object_mut().unwrap().remove("channel");
+        assert_eq!(serde_json::from_value::<Study>(old).unwrap().channel, None);
     }
 }

@@ -1,5 +1,6 @@
 //! The study's self-contained HTML page (maud; inline CSS, figures inlined as SVG).
 
+use super::channel::{ChannelRow, ChannelStudy};
 use super::record::{RunRow, Study};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
@@ -54,6 +55,53 @@ fn run_row(r: &RunRow, front: bool) -> Markup {
     }
 }
 
+fn snake<T: serde::Serialize>(v: T) -> String {
+    serde_json::to_value(v).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()
+}
+
+fn channel_row(r: &ChannelRow, front: bool) -> Markup {
+    let ms = if r.steps > 0 { format!("{:.3}", 1e3 * r.wall_s / r.steps as f64) } else { "—".into() };
+    html! {
+        tr class=(if front { "front" } else { "" }) {
+            td class="l" { code { (r.id) } }
+            td { (format!("{:.5}", r.dx)) }
+            td class="l" { (snake(r.variant.viscosity)) }
+            td class="l" { (snake(r.variant.shifting)) }
+            td class="l" { (snake(r.variant.ppe)) }
+            td class="l" { (r.preset.as_deref().unwrap_or("")) }
+            td { (r.threads) }
+            td { (r.particles) }
+            td { (r.steps) }
+            td { (format!("{:.3}", r.wall_s)) }
+            td { (r.cpu_s.map_or("—".into(), |c| format!("{:.2}", c / r.wall_s.max(1e-12)))) }
+            td { (ms) }
+            td { (format!("{:.1}", r.ppe_iterations_mean)) }
+            td { (pct(r.error)) }
+            td { (pct(r.error_startup_max)) }
+            td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
+        }
+    }
+}
+
+fn channel_section(c: &ChannelStudy) -> Markup {
+    html! {
+        h2 { "Periodic channel" }
+        p {
+            "Case " code { (c.case) } " (preset re4, mirror walls, periodic in x), from rest to τ = νt/D² = 1. Error: "
+            (c.error_metric) ". Bold rows are on the Pareto front of (error, wall time)."
+        }
+        ul { @for d in &c.design { li { (d) } } }
+        table class="small" {
+            tr {
+                th class="l" { "run" } th { "Δx" } th class="l" { "viscosity" } th class="l" { "shifting" } th class="l" { "PPE" }
+                th class="l" { "preset" } th { "threads" } th { "particles" } th { "steps" } th { "wall [s]" } th { "CPU/wall" }
+                th { "ms/step" } th { "PPE its" } th { "profile error (τ = 1)" } th { "start-up max" } th class="l" { "status" }
+            }
+            @for r in &c.runs { (channel_row(r, c.pareto.contains(&r.id))) }
+        }
+    }
+}
+
 /// The page of a study, with its figures inlined.
 pub fn render(study: &Study, figures: &[Figure]) -> String {
     let m = &study.machine;
@@ -66,17 +114,18 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
         html lang="en" {
             head {
                 meta charset="utf-8";
-                title { "Meniscus work-precision study (elliptical drop)" }
+                title { "Meniscus work-precision study (elliptical drop, periodic channel)" }
                 style { (PreEscaped(CSS)) }
             }
             body {
-                h1 { "Work-precision study: elliptical drop" }
+                h1 { "Work-precision study: elliptical drop and periodic channel" }
                 p {
                     "Wall time against the relative error of the semi-axis b at t = 0.008 s (second moments, against the ellipse ODE), for "
                     (study.runs.len()) " runs of the " code { (study.case) } " scene ("
                     (diverged) " diverged), tier " b { (study.tier) } ", " (study.threads) " threads for the main runs; the study took "
-                    (format!("{:.0}", study.elapsed_s)) " s."
+                    (format!("{:.0}", study.elapsed_s)) " s (both studies)."
                     @if !study.complete { " " b { "Incomplete: the study was interrupted." } }
+                    @if study.channel.is_some() { " The periodic channel's study has its own section and figure below." }
                 }
                 h2 { "Targets" }
                 table {
@@ -130,6 +179,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                         }
                     }
                 }
+                @if let Some(c) = &study.channel { (channel_section(c)) }
                 h2 { "Design" }
                 ul { @for d in &study.design { li { (d) } } }
                 p class="small" {

@@ -5,6 +5,7 @@
 //! times, fits against particle count, speed-ups), so they live here with the same look
 //! (size, fonts, palette, legend on a translucent box).
 
+use super::channel::ChannelRow;
 use super::record::{CostFit, RunRow, SpeedUp};
 use super::targets::thresholds;
 use crate::error::{HarnessError, Result};
@@ -75,68 +76,82 @@ fn percent(v: f64) -> String {
     format!("{p:.digits$} %")
 }
 
-/// Distinct spacings of the rows, coarse to fine.
-fn spacings(rows: &[&RunRow]) -> Vec<f64> {
-    let mut dx: Vec<f64> = rows.iter().map(|r| r.dx).collect();
+/// Distinct spacings, coarse to fine.
+fn spacings(dx: impl Iterator<Item = f64>) -> Vec<f64> {
+    let mut dx: Vec<f64> = dx.collect();
     dx.sort_by(|a, b| b.total_cmp(a));
     dx.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
     dx
 }
 
-/// Wall time against b error (log-log), one colour per spacing; the Pareto front (ids in
-/// `front`, cheapest first) joined by a black line; the presets labelled; the target box
-/// (b error ≤ 0.5 % within 1 s) dashed.
-pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<String> {
-    let pts: Vec<(&RunRow, f64)> = runs
-        .iter()
-        .filter(|r| r.ok())
-        .filter_map(|r| r.b_err.filter(|e| *e > 0.0).map(|e| (*r, e)))
-        .collect();
-    let (x0, x1) = log_range(pts.iter().map(|p| p.1).chain([thresholds::B_ERR]), 1.6);
-    let (y0, y1) = log_range(pts.iter().map(|p| p.0.wall_s).chain([thresholds::B_ERR_WALL_S]), 1.6);
-    let rows: Vec<&RunRow> = pts.iter().map(|p| p.0).collect();
-    let dxs = spacings(&rows);
+/// One point of a work-precision chart.
+struct Point<'a> {
+    id: &'a str,
+    dx: f64,
+    error: f64,
+    wall_s: f64,
+    /// Text drawn at the point (the presets), if any.
+    label: Option<String>,
+}
+
+/// A spacing rounded for a legend (D/36 = 0.005556).
+fn dx_text(dx: f64) -> String {
+    format!("{}", (dx * 1e6).round() / 1e6)
+}
+
+/// Wall time against error (log-log), one colour per spacing; the Pareto front (ids in
+/// `front`, cheapest first) joined by a black line; labelled points; the dashed target
+/// box (error ≤ `target.0` within `target.1` s), if any.
+fn front_chart(
+    file: &str,
+    title: &str,
+    x_desc: &str,
+    pts: &[Point],
+    front: &[String],
+    target: Option<(f64, f64, &str)>,
+) -> Result<String> {
+    let (x0, x1) = log_range(pts.iter().map(|p| p.error).chain(target.map(|t| t.0)), 1.6);
+    let (y0, y1) = log_range(pts.iter().map(|p| p.wall_s).chain(target.map(|t| t.1)), 1.6);
+    let dxs = spacings(pts.iter().map(|p| p.dx));
     svg(file, |root| {
-        let mut chart = chart_builder(root, "Work-precision: wall time against b error at t = 0.008 s")
+        let mut chart = chart_builder(root, title)
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(boxed)?;
         chart
             .configure_mesh()
-            .x_desc("relative b error at t = 0.008 s")
+            .x_desc(x_desc)
             .y_desc("wall time [s]")
             .x_label_formatter(&|v| percent(*v))
             .y_label_formatter(&|v| format!("{v:.2}"))
             .draw()
             .map_err(boxed)?;
-        let grey = RGBColor(120, 120, 120);
-        chart
-            .draw_series(DashedLineSeries::new(
-                [
-                    (x0, thresholds::B_ERR_WALL_S),
-                    (thresholds::B_ERR, thresholds::B_ERR_WALL_S),
-                    (thresholds::B_ERR, y0),
-                ],
-                6,
-                4,
-                grey.stroke_width(1),
-            ))
-            .map_err(boxed)?
-            .label("target: b error ≤ 0.5 % within 1 s")
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        if let Some((err, wall, text)) = target {
+            let grey = RGBColor(120, 120, 120);
+            chart
+                .draw_series(DashedLineSeries::new(
+                    [(x0, wall), (err, wall), (err, y0)],
+                    6,
+                    4,
+                    grey.stroke_width(1),
+                ))
+                .map_err(boxed)?
+                .label(text)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], grey));
+        }
         for (i, dx) in dxs.iter().enumerate() {
             let c = colour(i);
             let mine: Vec<(f64, f64)> =
-                pts.iter().filter(|p| (p.0.dx - dx).abs() < 1e-12).map(|p| (p.1, p.0.wall_s)).collect();
+                pts.iter().filter(|p| (p.dx - dx).abs() < 1e-12).map(|p| (p.error, p.wall_s)).collect();
             chart
                 .draw_series(mine.iter().map(|&p| Circle::new(p, 3, c.mix(0.75).filled())))
                 .map_err(boxed)?
-                .label(format!("Δx = {dx} ({} runs)", mine.len()))
+                .label(format!("Δx = {} ({} runs)", dx_text(*dx), mine.len()))
                 .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
         }
         let front_pts: Vec<(f64, f64)> = front
             .iter()
-            .filter_map(|id| pts.iter().find(|p| &p.0.id == id))
-            .map(|p| (p.1, p.0.wall_s))
+            .filter_map(|id| pts.iter().find(|p| p.id == id))
+            .map(|p| (p.error, p.wall_s))
             .collect();
         chart
             .draw_series(LineSeries::new(front_pts.clone(), BLACK.stroke_width(2)))
@@ -148,13 +163,63 @@ pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<
             .map_err(boxed)?;
         chart
             .draw_series(pts.iter().filter_map(|p| {
-                p.0.preset.as_ref().map(|name| {
-                    Text::new(format!("{name} Δx={}", p.0.dx), (p.1, p.0.wall_s), ("sans-serif", 11))
-                })
+                p.label.as_ref().map(|name| Text::new(name.clone(), (p.error, p.wall_s), ("sans-serif", 11)))
             }))
             .map_err(boxed)?;
         legend(&mut chart, SeriesLabelPosition::UpperRight)
     })
+}
+
+/// The drop's chart: wall time against b error at t = 0.008 s (finished runs), the
+/// presets labelled, the target box (b error ≤ 0.5 % within 1 s).
+pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<String> {
+    let pts: Vec<Point> = runs
+        .iter()
+        .filter(|r| r.ok())
+        .filter_map(|r| {
+            r.b_err.filter(|e| *e > 0.0).map(|error| Point {
+                id: &r.id,
+                dx: r.dx,
+                error,
+                wall_s: r.wall_s,
+                label: r.preset.as_ref().map(|name| format!("{name} Δx={}", r.dx)),
+            })
+        })
+        .collect();
+    front_chart(
+        file,
+        "Work-precision: wall time against b error at t = 0.008 s",
+        "relative b error at t = 0.008 s",
+        &pts,
+        front,
+        Some((thresholds::B_ERR, thresholds::B_ERR_WALL_S, "target: b error ≤ 0.5 % within 1 s")),
+    )
+}
+
+/// The channel's chart: wall time against the steady profile error at τ = 1 (finished
+/// runs), the case's presets (`re4`, `re4_implicit`) labelled.
+pub fn channel_work_precision(file: &str, runs: &[&ChannelRow], front: &[String]) -> Result<String> {
+    let pts: Vec<Point> = runs
+        .iter()
+        .filter(|r| r.ok())
+        .filter_map(|r| {
+            r.error.filter(|e| *e > 0.0).map(|error| Point {
+                id: &r.id,
+                dx: r.dx,
+                error,
+                wall_s: r.wall_s,
+                label: r.preset.as_ref().map(|name| format!("{name} Δx={}", dx_text(r.dx))),
+            })
+        })
+        .collect();
+    front_chart(
+        file,
+        "Periodic channel (Re = 4): wall time against the steady profile error",
+        "relative L2 error of the velocity profile at τ = 1",
+        &pts,
+        front,
+        None,
+    )
 }
 
 /// Horizontal stacked bars: microseconds per particle and step spent in each stage, for

@@ -1,5 +1,6 @@
 //! What `reports/work_precision/results.json` holds.
 
+use super::channel::ChannelStudy;
 use super::design::Variant;
 use crate::provenance::Provenance;
 use serde::{Deserialize, Serialize};
@@ -151,7 +152,8 @@ pub struct Machine {
 pub struct Study {
     /// `work_precision`.
     pub study: String,
-    /// The case whose scene and reference are used (`elliptical_drop`).
+    /// The case of the main study and of the targets (`elliptical_drop`; the channel's is
+    /// in `channel.case`).
     pub case: String,
     /// `quick`, `default` or `full`.
     pub tier: String,
@@ -180,4 +182,7 @@ pub struct Study {
     pub speedups: Vec<SpeedUp>,
     /// The targets.
     pub targets: Vec<Target>,
+    /// The periodic channel's study (absent in files written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub channel: Option<ChannelStudy>,
 }

@@ -1,0 +1,393 @@
+//! The second study of `cargo xtask bench`: the periodic Poiseuille channel
+//! (`validation/poiseuille_periodic.json`, preset `re4`: Re = U D/ν = 4, mirror walls, one
+//! periodic axis) from rest to τ = ν t/D² = 1, wall time against the steady profile error
+//! `u_profile_l2_rel_steady` = `sqrt(Σ (u − u_ref)² / Σ u_ref²)` over the bins at τ = 1
+//! against the start-up series of Morris, Fox & Zhu 1997 (`metrics::poiseuille`).
+//!
+//! Factors, one at a time around each viscous integration (explicit, Qiu eq. 13, bound by
+//! the viscous limit Δt ≤ α_d ρ h²/μ; implicit backward Euler, bound by the CFL limit and
+//! the case's 100 s cap): Xu shifting coefficient (C = 0.02, the case's, or 0.01) and PPE
+//! solver (BiCGSTAB 1e-3, the case's, or CG 1e-3).
+
+use super::Outcome;
+use crate::case::{Case, Tier};
+use crate::error::{HarnessError, Result};
+use crate::metrics;
+use meniscus::Scene;
+use meniscus::scene::schema::{PpeSolver, Scheme, Shifting, ViscousIntegration};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// The case file of the study (`validation/<CASE>.json`).
+pub const CASE: &str = "poiseuille_periodic";
+
+/// The case preset the variants start from.
+pub const PRESET: &str = "re4";
+
+/// The error metric of the study.
+pub const METRIC: &str = "u_profile_l2_rel_steady";
+
+/// The channel spacings \[m\]: D/36 (the paper's 0.0055), 0.004, 0.0025.
+pub const D36: f64 = 0.2 / 36.0;
+
+/// Viscous integration of the predictor.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Viscosity {
+    /// Forward Euler (Qiu 2013 eq. 13), with the viscous time-step limit.
+    Explicit,
+    /// Backward Euler (`scheme.isph.viscosity: implicit`), no viscous limit.
+    Implicit,
+}
+
+/// Xu shifting coefficient C (Qiu 2013 eqs. 20–21).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChannelShift {
+    /// C = 0.02 (the case's).
+    Xu002,
+    /// C = 0.01.
+    Xu001,
+}
+
+/// PPE solver at tolerance 1e-3 (Jacobi preconditioner: the periodic mirror channel has no
+/// Dirichlet row, where the two-level preconditioner keeps Jacobi).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ChannelPpe {
+    /// BiCGSTAB (the case's).
+    Bicgstab,
+    /// Conjugate gradient.
+    Cg,
+}
+
+/// One option set of the channel study.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub struct ChannelVariant {
+    /// Viscous integration.
+    pub viscosity: Viscosity,
+    /// Shifting coefficient.
+    pub shifting: ChannelShift,
+    /// PPE solver.
+    pub ppe: ChannelPpe,
+}
+
+impl ChannelVariant {
+    /// The case's `re4` preset: explicit viscosity, Xu C = 0.02, BiCGSTAB 1e-3.
+    pub const EXPLICIT: ChannelVariant = ChannelVariant {
+        viscosity: Viscosity::Explicit,
+        shifting: ChannelShift::Xu002,
+        ppe: ChannelPpe::Bicgstab,
+    };
+
+    /// The case's `re4_implicit` preset: `re4` with the backward-Euler predictor.
+    pub const IMPLICIT: ChannelVariant =
+        ChannelVariant { viscosity: Viscosity::Implicit, ..ChannelVariant::EXPLICIT };
+
+    /// The case preset this option set is, if any (`re4`, `re4_implicit`).
+    pub fn preset(&self) -> Option<&'static str> {
+        match *self {
+            ChannelVariant::EXPLICIT => Some("re4"),
+            ChannelVariant::IMPLICIT => Some("re4_implicit"),
+            _ => None,
+        }
+    }
+
+    /// A short label, e.g. `explicit xu0.02 bicgstab_1e-3`.
+    pub fn label(&self) -> String {
+        let v = match self.viscosity {
+            Viscosity::Explicit => "explicit",
+            Viscosity::Implicit => "implicit",
+        };
+        let s = match self.shifting {
+            ChannelShift::Xu002 => "xu0.02",
+            ChannelShift::Xu001 => "xu0.01",
+        };
+        let p = match self.ppe {
+            ChannelPpe::Bicgstab => "bicgstab_1e-3",
+            ChannelPpe::Cg => "cg_1e-3",
+        };
+        format!("{v} {s} {p}")
+    }
+
+    /// This variant and its one-factor changes (shifting, then PPE solver).
+    pub fn one_factor_at_a_time(&self) -> Vec<ChannelVariant> {
+        let shifting = match self.shifting {
+            ChannelShift::Xu002 => ChannelShift::Xu001,
+            ChannelShift::Xu001 => ChannelShift::Xu002,
+        };
+        let ppe = match self.ppe {
+            ChannelPpe::Bicgstab => ChannelPpe::Cg,
+            ChannelPpe::Cg => ChannelPpe::Bicgstab,
+        };
+        vec![*self, ChannelVariant { shifting, ..*self }, ChannelVariant { ppe, ..*self }]
+    }
+
+    /// Applies the variant to a channel scene (an ISPH scene; others are left alone).
+    pub fn apply(&self, scene: &mut Scene) {
+        let Scheme::Isph(o) = &mut scene.scheme else {
+            return;
+        };
+        o.viscosity = match self.viscosity {
+            Viscosity::Explicit => ViscousIntegration::Explicit,
+            Viscosity::Implicit => ViscousIntegration::Implicit,
+        };
+        o.shifting = Shifting::Xu {
+            coefficient: match self.shifting {
+                ChannelShift::Xu002 => 0.02,
+                ChannelShift::Xu001 => 0.01,
+            },
+        };
+        (o.ppe.solver, o.ppe.tolerance) = match self.ppe {
+            ChannelPpe::Bicgstab => (PpeSolver::Bicgstab, 1e-3),
+            ChannelPpe::Cg => (PpeSolver::Cg, 1e-3),
+        };
+    }
+}
+
+/// One planned channel run.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ChannelPlanned {
+    /// Spacing \[m\].
+    pub dx: f64,
+    /// Option set.
+    pub variant: ChannelVariant,
+    /// Rayon threads.
+    pub threads: usize,
+}
+
+impl ChannelPlanned {
+    /// A stable id, e.g. `channel_dx0.004_t2_explicit-xu0.02-bicgstab_1e-3`.
+    pub fn id(&self) -> String {
+        format!("channel_dx{:.5}_t{}_{}", self.dx, self.threads, self.variant.label().replace(' ', "-"))
+    }
+}
+
+/// The channel runs of a tier, coarse spacings first:
+/// - quick: D/36, both viscous integrations with the case's other options (2 runs);
+/// - default: D/36 and 0.004, each viscous integration and its one-factor changes
+///   (12 runs);
+/// - full: the default design at D/36, 0.004 and 0.0025 (18 runs).
+pub fn design(tier: Tier, threads: usize) -> (Vec<ChannelPlanned>, String) {
+    let (spacings, variants): (&[f64], Vec<ChannelVariant>) = match tier {
+        Tier::Quick => (&[D36], vec![ChannelVariant::EXPLICIT, ChannelVariant::IMPLICIT]),
+        Tier::Default | Tier::Full => {
+            let mut v = ChannelVariant::EXPLICIT.one_factor_at_a_time();
+            v.extend(ChannelVariant::IMPLICIT.one_factor_at_a_time());
+            (if tier == Tier::Full { &[D36, 0.004, 0.0025] } else { &[D36, 0.004] }, v)
+        }
+    };
+    let runs = spacings
+        .iter()
+        .flat_map(|&dx| variants.iter().map(move |&variant| ChannelPlanned { dx, variant, threads }))
+        .collect();
+    let dx = spacings.iter().map(|d| format!("{d:.5}")).collect::<Vec<_>>().join(", ");
+    let which = if tier == Tier::Quick {
+        "explicit and implicit viscosity with the case's options"
+    } else {
+        "explicit and implicit viscosity, each with Xu C = 0.01 instead of 0.02 and with CG instead of BiCGSTAB"
+    };
+    (runs, format!("Periodic channel (Re = 4, to τ = 1), Δx = {dx}: {which}."))
+}
+
+/// The scene of `variant` at `dx`: the case's `re4` preset at `dx`, then the variant.
+pub fn scene(case: &Case, variant: &ChannelVariant, dx: f64) -> Result<Scene> {
+    let value = crate::sweep::effective_scene(case, PRESET, dx)?;
+    let run = format!("work-precision dx{dx} {}", variant.label());
+    let mut scene = Scene::from_json(&value.to_string()).map_err(|source| HarnessError::Scene {
+        case: case.case.clone(),
+        run: run.clone(),
+        source,
+    })?;
+    variant.apply(&mut scene);
+    meniscus::scene::validate(&scene).map_err(|source| HarnessError::Scene {
+        case: case.case.clone(),
+        run,
+        source,
+    })?;
+    Ok(scene)
+}
+
+/// One channel run. A diverged run is a row with its status and no error value.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChannelRow {
+    /// Stable id ([`ChannelPlanned::id`]).
+    pub id: String,
+    /// Spacing \[m\].
+    pub dx: f64,
+    /// The option set.
+    #[serde(flatten)]
+    pub variant: ChannelVariant,
+    /// `re4` or `re4_implicit` when the option set is one of the case's presets.
+    pub preset: Option<String>,
+    /// Rayon threads.
+    pub threads: usize,
+    /// Particles (fluid).
+    pub particles: usize,
+    /// Steps taken.
+    pub steps: usize,
+    /// Time reached \[s\].
+    pub t_end: f64,
+    /// Wall time of the stepping loop \[s\].
+    pub wall_s: f64,
+    /// CPU time of the process over the run \[s\] (see `RunRow::cpu_s`).
+    pub cpu_s: Option<f64>,
+    /// Seconds per stage.
+    pub stages: BTreeMap<String, f64>,
+    /// Mean PPE iterations per step.
+    pub ppe_iterations_mean: f64,
+    /// Steady profile error at τ = 1 (`u_profile_l2_rel_steady`); `None` when diverged.
+    pub error: Option<f64>,
+    /// Largest start-up profile error, τ < 1 (`u_profile_l2_rel_startup_max`).
+    pub error_startup_max: Option<f64>,
+    /// `ok` or `diverged: <cause>`.
+    pub status: String,
+}
+
+impl ChannelRow {
+    /// Whether the run reached its end time.
+    pub fn ok(&self) -> bool {
+        self.status == "ok"
+    }
+}
+
+/// The channel study in `results.json` (its `channel` field).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ChannelStudy {
+    /// `poiseuille_periodic`.
+    pub case: String,
+    /// The error measure.
+    pub error_metric: String,
+    /// The parts of the design.
+    pub design: Vec<String>,
+    /// Every run, in the order run.
+    pub runs: Vec<ChannelRow>,
+    /// Ids of the runs on the Pareto front of (error, wall time), cheapest first.
+    pub pareto: Vec<String>,
+}
+
+impl ChannelStudy {
+    /// An empty study of `design`.
+    pub fn new(design: String) -> ChannelStudy {
+        ChannelStudy {
+            case: CASE.into(),
+            error_metric: format!(
+                "{METRIC}: sqrt(Σ (u − u_ref)² / Σ u_ref²) over the velocity bins at τ = νt/D² = 1 (Re = 4), \
+                 against the Morris, Fox & Zhu 1997 start-up series"
+            ),
+            design: vec![design],
+            runs: Vec::new(),
+            pareto: Vec::new(),
+        }
+    }
+
+    /// Fills the Pareto front from the finished runs.
+    pub fn derive(&mut self) {
+        let pts: Vec<(&ChannelRow, (f64, f64))> = self
+            .runs
+            .iter()
+            .filter(|r| r.ok())
+            .filter_map(|r| r.error.filter(|e| e.is_finite()).map(|e| (r, (e, r.wall_s))))
+            .collect();
+        let xy: Vec<(f64, f64)> = pts.iter().map(|p| p.1).collect();
+        self.pareto = super::pareto::front(&xy).into_iter().map(|i| pts[i].0.id.clone()).collect();
+    }
+}
+
+/// The row of a planned run from its outcome.
+pub fn row(case: &Case, planned: &ChannelPlanned, scene: &Scene, outcome: Outcome) -> Result<ChannelRow> {
+    let mut row = ChannelRow {
+        id: planned.id(),
+        dx: planned.dx,
+        variant: planned.variant,
+        preset: planned.variant.preset().map(str::to_string),
+        threads: planned.threads,
+        particles: 0,
+        steps: 0,
+        t_end: 0.0,
+        wall_s: 0.0,
+        cpu_s: outcome.cpu_s,
+        stages: BTreeMap::new(),
+        ppe_iterations_mean: 0.0,
+        error: None,
+        error_startup_max: None,
+        status: "ok".into(),
+    };
+    let report = match outcome.report {
+        Ok(report) => report,
+        Err(msg) => {
+            row.status = format!("diverged: the solver panicked: {msg}");
+            return Ok(row);
+        }
+    };
+    let s = &report.summary;
+    (row.particles, row.steps, row.t_end, row.wall_s) = (s.particles, s.steps, s.t_end, s.wall_s);
+    row.stages = s.stages.clone();
+    row.ppe_iterations_mean = s.ppe_iterations_mean;
+    if let Some(e) = &report.error {
+        row.status = format!("diverged: {e}");
+        return Ok(row);
+    }
+    let scene_json = serde_json::to_value(scene).unwrap_or_default();
+    let measured = metrics::compute(&case.reference, &scene_json, &report.probes, s.particles)
+        .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
+    let get = |k: &str| measured.metrics.get(k).copied().filter(|v| v.is_finite());
+    row.error = get(METRIC);
+    row.error_startup_max = get("u_profile_l2_rel_startup_max");
+    Ok(row)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::collections::HashSet;
+    use std::path::Path;
+
+    fn case() -> Case {
+        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/poiseuille_periodic.json"))
+            .unwrap()
+    }
+
+    #[test]
+    fn presets_match_the_case_file() {
+        let c = case();
+        for v in [ChannelVariant::EXPLICIT, ChannelVariant::IMPLICIT] {
+            let name = v.preset().unwrap();
+            for dx in [D36, 0.0025] {
+                assert_eq!(
+                    scene(&c, &v, dx).unwrap(),
+                    crate::sweep::spec(&c, name, dx).unwrap().scene,
+                    "{name} {dx}"
+                );
+            }
+        }
+        let s = scene(
+            &c,
+            &ChannelVariant {
+                shifting: ChannelShift::Xu001,
+                ppe: ChannelPpe::Cg,
+                ..ChannelVariant::IMPLICIT
+            },
+            0.004,
+        )
+        .unwrap();
+        let Scheme::Isph(o) = &s.scheme else { panic!("an ISPH scene") };
+        assert_eq!(o.shifting, Shifting::Xu { coefficient: 0.01 });
+        assert_eq!(o.ppe.solver, PpeSolver::Cg);
+        assert_eq!(o.viscosity, ViscousIntegration::Implicit);
+    }
+
+    #[test]
+    fn design_sizes() {
+        let (quick, _) = design(Tier::Quick, 2);
+        assert_eq!(quick.len(), 2);
+        let (default, text) = design(Tier::Default, 2);
+        assert_eq!(default.len(), 12);
+        assert!(text.contains("0.00400"));
+        let (full, _) = design(Tier::Full, 2);
+        assert_eq!(full.len(), 18);
+        let ids: HashSet<String> = full.iter().map(ChannelPlanned::id).collect();
+        assert_eq!(ids.len(), 18, "ids are unique");
+        assert!(full.windows(2).all(|w| w[0].dx >= w[1].dx), "coarse first");
+    }
+}
