@@ -58,12 +58,6 @@ impl<K: Kernel, const D: usize> SurfacePressure<K, D> {
     pub fn new(sigma: f64, threshold: f64, kernel: Scaled<K, D>) -> Self {
         Self { sigma, eps: threshold / kernel.h, kernel, normal: Vec::new(), kappa: Vec::new() }
     }
-
-    /// Smoothed curvature of the free-surface particles after the last run, at the
-    /// particles' own positions \[1/m\] (NaN where none was measured).
-    pub fn curvature(&self) -> &[f64] {
-        &self.kappa
-    }
 }
 
 /// Unit colour-gradient normals `n̂_a` (into the fluid) of the fluid particles, zero where
@@ -136,27 +130,7 @@ impl<K: Kernel, const D: usize> Stage<D> for SurfacePressure<K, D> {
                 }
             })
             .collect();
-        let (list, pairs, kernel) = (&s.neighbours, &s.pairs, &self.kernel);
-        let w0 = kernel.w(0.0);
-        self.kappa.resize(nf, f64::NAN);
-        self.kappa.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, k)| {
-            *k = f64::NAN;
-            if !raw[a].is_finite() {
-                return;
-            }
-            let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
-            let (mut num, mut den) = (w0 * raw[a], w0);
-            for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                if let Some(&kb) = raw.get(b as usize)
-                    && kb.is_finite()
-                {
-                    let w = kernel.w(p.r2.sqrt());
-                    num += w * kb;
-                    den += w;
-                }
-            }
-            *k = num / den;
-        });
+        shepard(s, &self.kernel, &raw, &mut self.kappa);
         let (sigma, half) = (self.sigma, 0.5 * s.dx);
         let (kappa, fs) = (&self.kappa, &s.free_surface);
         s.particles.p[..nf].par_iter_mut().enumerate().with_min_len(1024).for_each(|(a, p)| {
@@ -167,4 +141,30 @@ impl<K: Kernel, const D: usize> Stage<D> for SurfacePressure<K, D> {
         });
         Ok(())
     }
+}
+
+/// Shepard filter of `raw` over the particles where it is finite:
+/// `out_a = Σ_b W_ab raw_b / Σ_b W_ab` (b = a included; NaN where `raw_a` is NaN).
+fn shepard<K: Kernel, const D: usize>(s: &State<D>, kernel: &Scaled<K, D>, raw: &[f64], out: &mut Vec<f64>) {
+    let (list, pairs) = (&s.neighbours, &s.pairs);
+    let w0 = kernel.w(0.0);
+    out.resize(raw.len(), f64::NAN);
+    out.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, k)| {
+        *k = f64::NAN;
+        if !raw[a].is_finite() {
+            return;
+        }
+        let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
+        let (mut num, mut den) = (w0 * raw[a], w0);
+        for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
+            if let Some(&kb) = raw.get(b as usize)
+                && kb.is_finite()
+            {
+                let w = kernel.w(p.r2.sqrt());
+                num += w * kb;
+                den += w;
+            }
+        }
+        *k = num / den;
+    });
 }
