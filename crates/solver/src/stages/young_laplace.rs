@@ -2,9 +2,9 @@
 //! projection scheme (`fluid.surface_tension_model: young_laplace`, ISPH only).
 //!
 //! With no fluid outside, the stress balance at a free surface is the Young–Laplace
-//! condition `p_s = σ κ` (Landau & Lifshitz, Fluid Mechanics §61, eq. 61.1 with no outer
-//! pressure; the normal viscous stress is neglected, as for the p = 0 free surface of Qiu
-//! 2013 §2.5). The projection already imposes a Dirichlet value on the free-surface
+//! condition `p_s = σ κ` (Laplace's formula, Landau & Lifshitz, Fluid Mechanics §61, with no
+//! outer pressure; the normal viscous stress is neglected, as for the p = 0 free surface of Qiu
+//! 2013, eq. 16). The projection already imposes a Dirichlet value on the free-surface
 //! particles (`free_surface` stage, Qiu eq. 16); this stage replaces its 0 by `σ κ`, so the
 //! surface force enters through the pressure gradient and no body force is needed.
 //!
@@ -62,7 +62,7 @@ impl<K: Kernel, const D: usize> SurfacePressure<K, D> {
 
 /// Unit colour-gradient normals `n̂_a` (into the fluid) of the fluid particles, zero where
 /// `|Σ_b V ∇_aW_ab| ≤ eps`.
-pub fn unit_normals<const D: usize>(s: &State<D>, eps: f64, out: &mut Vec<Vector<D>>) {
+fn unit_normals<const D: usize>(s: &State<D>, eps: f64, out: &mut Vec<Vector<D>>) {
     let (list, pairs, v) = (&s.neighbours, &s.pairs, s.volume);
     out.resize(s.particles.fluid, Vector::zeros());
     out.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, n)| {
