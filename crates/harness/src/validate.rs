@@ -229,13 +229,16 @@ pub fn assemble(case: &Case, tier: Tier, records: &[RunRecord]) -> Result<CaseRe
     })
 }
 
-/// Observed orders of the case's convergence metrics, from the runs that completed.
+/// Observed orders of the case's convergence metrics, from the runs that completed. The
+/// headline order is the primary preset's; when that preset has no fit (runs diverged or
+/// the metric is undefined), the first preset (by name) that has one.
 pub fn convergence(case: &Case, runs: &[RunResult]) -> BTreeMap<String, Convergence> {
     let primary = case.primary_preset();
     let mut out = BTreeMap::new();
     for metric in &case.convergence {
         let mut by_preset = BTreeMap::new();
         let mut primary_pts = None;
+        let mut fallback = None;
         let mut presets: Vec<&str> = runs.iter().map(|r| r.preset.as_str()).collect();
         presets.sort_unstable();
         presets.dedup();
@@ -250,14 +253,16 @@ pub fn convergence(case: &Case, runs: &[RunResult]) -> BTreeMap<String, Converge
             if let Some(fit) = fit_power_law(&dx, &e) {
                 by_preset.insert(preset.to_string(), fit.order);
                 if preset == primary {
-                    primary_pts = Some((fit.order, dx, e));
+                    primary_pts = Some((fit.order, preset, dx, e));
+                } else if fallback.is_none() {
+                    fallback = Some((fit.order, preset, dx, e));
                 }
             }
         }
-        if let Some((order, dx, values)) = primary_pts {
+        if let Some((order, preset, dx, values)) = primary_pts.or(fallback) {
             out.insert(
                 metric.clone(),
-                Convergence { order, preset: primary.to_string(), dx, values, by_preset },
+                Convergence { order, preset: preset.to_string(), dx, values, by_preset },
             );
         }
     }
@@ -328,6 +333,15 @@ mod tests {
         assert!((conv.by_preset["tuned"] - 2.0).abs() < 1e-9);
         // a is exact: no positive errors, no order.
         assert!(!res.convergence.contains_key("a_rel_err_max"));
+        // Without a fit of the primary preset the headline order is another preset's.
+        let partial = vec![
+            synthetic("paper", 0.04, 5.0, 1976),
+            synthetic("tuned", 0.04, 1.0, 1976),
+            synthetic("tuned", 0.02, 1.0, 7860),
+        ];
+        let conv = assemble(&drop_case(), Tier::Quick, &partial).unwrap().convergence;
+        assert_eq!(conv["b_rel_err_max"].preset, "tuned");
+        assert!((conv["b_rel_err_max"].order - 2.0).abs() < 1e-9);
         let names: Vec<&str> = res.checks.iter().map(|c| c.name.as_str()).collect();
         assert!(!names.iter().any(|n| n.contains("31428")), "dx=0.01 is not in the quick tier");
         let b = res.checks.iter().find(|c| c.name.starts_with("b error (moments")).unwrap();

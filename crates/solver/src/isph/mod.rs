@@ -4,7 +4,8 @@
 //! `reorder` (locality) → `advect` (eq. 3) → `walls` (§2.4.2; mirror walls only) →
 //! `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation) →
 //! `inlet_sources` (inflow only) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
-//! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
+//! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) or `surface_pressure`
+//! (σ > 0, `young_laplace`: p = σκ on the free surface) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
 //! `mirror_velocity` | `dummy_velocity` (walls only) → `ppe_assemble`
 //! (eqs. 10, 12) → `ppe_solve` (eq. 5) → `dummy_pressure` (dummy walls only) →
 //! `correction` (eqs. 6, 15) → `position` (eq. 7) →
@@ -24,7 +25,8 @@ use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
-use crate::stages::surface_tension::{Apply, SurfaceTension};
+use crate::stages::surface_tension::{Apply, Force, SurfaceTension};
+use crate::stages::young_laplace::SurfacePressure;
 use crate::stages::{free_surface::FreeSurface, reorder::Reorder, walls};
 use crate::state::Vector;
 
@@ -91,10 +93,16 @@ pub fn build_stages<K: Kernel, const D: usize>(
     if g.norm_squared() > 0.0 {
         stages.push(Box::new(predictor::BodyForce { g }));
     }
-    if scene.fluid.surface_tension > 0.0 {
+    let sigma = scene.fluid.surface_tension;
+    let force = Force::of(scene.fluid.surface_tension_model);
+    let young_laplace = sigma > 0.0 && force.is_none();
+    if young_laplace {
+        stages.push(Box::new(SurfacePressure::new(sigma, scene.fluid.surface_tension_threshold, kernel)));
+    }
+    if let Some(force) = force.filter(|_| sigma > 0.0) {
         stages.push(Box::new(SurfaceTension::new(
             crate::stages::surface_tension::effective_sigma(scene, &kernel),
-            scene.fluid.surface_tension_model,
+            force,
             scene.fluid.surface_tension_threshold,
             kernel.h,
             Apply::Velocity,
@@ -110,8 +118,16 @@ pub fn build_stages<K: Kernel, const D: usize>(
     }
     let relaxation = (opts.density_relaxation > 0.0)
         .then(|| (opts.density_relaxation, lattice_div_r(&kernel, scene.dx.powi(D as i32))));
-    stages.push(Box::new(projection::PpeAssemble { divergence: opts.divergence, relaxation, dt_max: 0.0 }));
-    stages.push(Box::new(projection::PpeSolveStage { solver: PpeSolve::new(opts.ppe) }));
+    stages.push(Box::new(projection::PpeAssemble {
+        divergence: opts.divergence,
+        relaxation,
+        dt_max: 0.0,
+        surface_pressure: young_laplace,
+    }));
+    stages.push(Box::new(projection::PpeSolveStage {
+        solver: PpeSolve::new(opts.ppe),
+        surface_pressure: young_laplace,
+    }));
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Pressure)));
     }

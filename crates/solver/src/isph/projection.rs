@@ -33,6 +33,10 @@ pub struct PpeAssemble {
     pub relaxation: Option<(f64, f64)>,
     /// Largest Δt so far \[s\] (density relaxation).
     pub dt_max: f64,
+    /// The free-surface particles carry known, non-zero pressures (the Young–Laplace
+    /// value σκ of `stages::young_laplace`), moved to the right-hand side like the known
+    /// boundary pressures; otherwise they are 0 and drop out.
+    pub surface_pressure: bool,
 }
 
 impl<const D: usize> Stage<D> for PpeAssemble {
@@ -124,6 +128,7 @@ impl<const D: usize> Stage<D> for PpeAssemble {
         let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
         self.dt_max = self.dt_max.max(ctx.dt);
         let (p, div_r, relaxation, dt_max) = (&s.particles.p, &s.div_r, self.relaxation, self.dt_max);
+        let surface_pressure = self.surface_pressure;
         sys.rhs.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
             let a = particle_of[i] as usize;
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
@@ -148,9 +153,11 @@ impl<const D: usize> Stage<D> for PpeAssemble {
             };
             // Known boundary pressures (dummy walls) move to the right-hand side.
             let mut known = 0.0;
-            if known_boundary {
+            if known_boundary || surface_pressure {
                 for (pr, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                    if b as usize >= n && row_of[b as usize] == u32::MAX {
+                    let boundary = b as usize >= n && known_boundary;
+                    let surface = (b as usize) < n && surface_pressure;
+                    if (boundary || surface) && row_of[b as usize] == u32::MAX {
                         known += -2.0 * v * pr.f * pr.r2 / (rho * (pr.r2 + eta2)) * p[b as usize];
                     }
                 }
@@ -166,11 +173,15 @@ impl<const D: usize> Stage<D> for PpeAssemble {
 }
 
 /// Solves the assembled PPE (Qiu eq. 5) with the scene's solver, warm-started from the
-/// previous pressure; writes p (zero on the free surface).
+/// previous pressure; writes p (zero on the free surface, or the known Young–Laplace
+/// value there with `surface_pressure`).
 #[derive(Debug)]
 pub struct PpeSolveStage {
     /// The configured solver.
     pub solver: PpeSolve,
+    /// Keep the free-surface pressures set before the solve (see
+    /// [`PpeAssemble::surface_pressure`]).
+    pub surface_pressure: bool,
 }
 
 impl<const D: usize> Stage<D> for PpeSolveStage {
@@ -186,8 +197,11 @@ impl<const D: usize> Stage<D> for PpeSolveStage {
             *x = p[a as usize];
         }
         sys.info = self.solver.solve(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular)?;
-        // Free-surface particles get p = 0; boundary particles keep their known values.
-        p[..s.particles.fluid].iter_mut().for_each(|v| *v = 0.0);
+        // Free-surface particles get p = 0 (or keep their Young–Laplace value); boundary
+        // particles keep their known values.
+        if !self.surface_pressure {
+            p[..s.particles.fluid].iter_mut().for_each(|v| *v = 0.0);
+        }
         for (x, &a) in sys.solution.iter().zip(&sys.particle_of) {
             p[a as usize] = *x;
         }

@@ -98,6 +98,9 @@ pub enum SurfaceTensionModel {
     HuAdams,
     /// Continuum surface force `σ κ ∇c` (Brackbill, Kothe & Zemach 1992).
     Csf,
+    /// Projection ISPH only: the Young–Laplace condition `p = σ κ` as the free-surface
+    /// Dirichlet value instead of a force (see [`crate::stages::young_laplace`]).
+    YoungLaplace,
 }
 
 /// A region filled with particles.

@@ -111,6 +111,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         Scheme::Isph(o) => validate_isph(o, d)?,
         Scheme::Wcsph(o) => validate_wcsph(o)?,
     }
+    validate_young_laplace(scene)?;
     positive("time.end", scene.time.end)?;
     match scene.time.step {
         TimeStep::Fixed(dt) => {
@@ -426,4 +427,29 @@ fn matrix(field: &str, m: &[Vec<f64>], d: usize) -> Result<(), SceneError> {
         vector(&format!("{field}[{i}]"), row, d)?;
     }
     Ok(())
+}
+
+/// `fluid.surface_tension_model: young_laplace` sets the free-surface pressure of the
+/// projection, so it needs the ISPH scheme and the difference pressure gradient (the
+/// symmetric form adds `2 p_a Σ V ∇W`, an outward push on surface particles whose pressure
+/// is not zero).
+fn validate_young_laplace(scene: &Scene) -> Result<(), SceneError> {
+    if scene.fluid.surface_tension_model != SurfaceTensionModel::YoungLaplace
+        || scene.fluid.surface_tension <= 0.0
+    {
+        return Ok(());
+    }
+    match &scene.scheme {
+        Scheme::Isph(o) if o.pressure_gradient == PressureGradient::Difference => Ok(()),
+        Scheme::Isph(_) => Err(SceneError::new(
+            "fluid.surface_tension_model",
+            "young_laplace",
+            "needs scheme.isph.pressure_gradient = \"difference\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)",
+        )),
+        Scheme::Wcsph(_) => Err(SceneError::new(
+            "fluid.surface_tension_model",
+            "young_laplace",
+            "is for the projection scheme (isph) only: it sets the free-surface Dirichlet pressure",
+        )),
+    }
 }

@@ -1,6 +1,6 @@
 //! Stages shared by every scheme: reordering, walls (mirror and dummy particles), open
 //! boundaries (inflow/outflow buffers), neighbour search with the pair cache, free-surface
-//! detection, surface tension.
+//! detection, surface tension (forces, or the Young–Laplace free-surface pressure).
 
 pub mod dummy;
 pub mod free_surface;
@@ -9,3 +9,4 @@ pub mod open_boundary;
 pub mod reorder;
 pub mod surface_tension;
 pub mod walls;
+pub mod young_laplace;

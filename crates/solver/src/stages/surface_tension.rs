@@ -84,6 +84,27 @@ pub fn effective_sigma<K: Kernel, const D: usize>(scene: &crate::scene::Scene, k
     if scene.fluid.surface_tension_normalise { sigma / flat_surface_delta(kernel, scene.dx) } else { sigma }
 }
 
+/// The force forms of this stage (`young_laplace` is a pressure condition instead:
+/// [`crate::stages::young_laplace`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Force {
+    /// Hu & Adams 2006 surface stress.
+    HuAdams,
+    /// Continuum surface force (Brackbill et al. 1992).
+    Csf,
+}
+
+impl Force {
+    /// The force form of a scene's model (None for `young_laplace`).
+    pub fn of(model: SurfaceTensionModel) -> Option<Self> {
+        match model {
+            SurfaceTensionModel::HuAdams => Some(Self::HuAdams),
+            SurfaceTensionModel::Csf => Some(Self::Csf),
+            SurfaceTensionModel::YoungLaplace => None,
+        }
+    }
+}
+
 /// Where the surface-tension acceleration goes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Apply {
@@ -98,7 +119,7 @@ pub enum Apply {
 pub struct SurfaceTension<const D: usize> {
     /// σ \[N/m\].
     sigma: f64,
-    model: SurfaceTensionModel,
+    model: Force,
     apply: Apply,
     /// ε = 0.01/h \[1/m\].
     eps: f64,
@@ -114,7 +135,7 @@ impl<const D: usize> SurfaceTension<D> {
     /// A stage with coefficient `sigma` \[N/m\] (already divided by the surface-delta
     /// integral when normalised, see [`flat_surface_delta`]), smoothing length `h` \[m\]
     /// and the normal threshold `ε = threshold / h`.
-    pub fn new(sigma: f64, model: SurfaceTensionModel, threshold: f64, h: f64, apply: Apply) -> Self {
+    pub fn new(sigma: f64, model: Force, threshold: f64, h: f64, apply: Apply) -> Self {
         Self { sigma, model, apply, eps: threshold / h, n: Vec::new(), stress: Vec::new(), accel: Vec::new() }
     }
 }
@@ -151,7 +172,7 @@ impl<const D: usize> Stage<D> for SurfaceTension<D> {
             (l > 0.0).then(|| v / l)
         };
         match self.model {
-            SurfaceTensionModel::HuAdams => {
+            Force::HuAdams => {
                 self.stress.resize(nf, SMatrix::zeros());
                 self.stress.par_iter_mut().zip(n.par_iter()).with_min_len(512).for_each(|(st, n)| {
                     let l = n.norm();
@@ -180,7 +201,7 @@ impl<const D: usize> Stage<D> for SurfaceTension<D> {
                     *acc = sum / (dens(a) * va);
                 });
             }
-            SurfaceTensionModel::Csf => {
+            Force::Csf => {
                 self.accel.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, acc)| {
                     let Some(na) = unit(a) else {
                         *acc = Vector::zeros();

@@ -21,7 +21,7 @@ use crate::scene::{Scene, WallModel, WcsphOptions};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::neighbours::{Neighbours, Rows};
-use crate::stages::surface_tension::{Apply, SurfaceTension};
+use crate::stages::surface_tension::{Apply, Force, SurfaceTension};
 use crate::stages::{reorder::Reorder, walls};
 use crate::state::Vector;
 use eos::Tait;
@@ -72,10 +72,11 @@ pub fn build_stages<K: Kernel, const D: usize>(
     };
     let sigma = crate::stages::surface_tension::effective_sigma(scene, &kernel);
     let tension = || -> Option<Box<dyn Stage<D>>> {
-        (sigma > 0.0).then(|| {
+        // `young_laplace` (no force form) is rejected for WCSPH by the scene validation.
+        Force::of(scene.fluid.surface_tension_model).filter(|_| sigma > 0.0).map(|force| {
             Box::new(SurfaceTension::new(
                 sigma,
-                scene.fluid.surface_tension_model,
+                force,
                 scene.fluid.surface_tension_threshold,
                 kernel.h,
                 Apply::Acceleration,
