@@ -298,25 +298,11 @@ impl<const D: usize> CellSearch<D> {
             ((base[0] - 1).max(0), (base[0] + 1).min(d0 - 1))
         };
         let mut off = [-1isize; D];
-        'rows: loop {
-            let mut row = 0usize;
-            let mut valid = true;
-            for k in (1..D).rev() {
-                let mut i = base[k] + off[k];
-                let dk = self.dims[k] as isize;
-                if self.domain.periodic[k].is_some() {
-                    if dk < 3 && off[k] != 0 && (dk == 1 || off[k] == 1) {
-                        valid = false;
-                        break;
-                    }
-                    i = i.rem_euclid(dk);
-                } else if i < 0 || i >= dk {
-                    valid = false;
-                    break;
-                }
-                row = row * self.dims[k] + i as usize;
-            }
-            if valid {
+        loop {
+            let row = (1..D)
+                .rev()
+                .try_fold(0usize, |row, k| Some(row * self.dims[k] + self.axis_cell(k, base[k], off[k])?));
+            if let Some(row) = row {
                 let first = row * self.dims[0];
                 let (s, e) = (
                     self.cell_start[first + lo0 as usize] as usize,
@@ -326,17 +312,8 @@ impl<const D: usize> CellSearch<D> {
                     f(j);
                 }
             }
-            let mut k = 1;
-            loop {
-                if k >= D {
-                    break 'rows;
-                }
-                off[k] += 1;
-                if off[k] <= 1 {
-                    break;
-                }
-                off[k] = -1;
-                k += 1;
+            if !next_offset(&mut off, 1) {
+                return;
             }
         }
     }
@@ -356,45 +333,54 @@ impl<const D: usize> CellSearch<D> {
     /// (axis 0 fastest; each cell once, also when a periodic axis has fewer than 3 cells).
     fn visit_cells(&self, base: &[isize; D], mut f: impl FnMut(u32)) {
         let mut off = [-1isize; D];
-        'cells: loop {
-            let mut id = 0usize;
-            let mut valid = true;
-            for k in (0..D).rev() {
-                let mut i = base[k] + off[k];
-                let dk = self.dims[k] as isize;
-                if self.domain.periodic[k].is_some() {
-                    // With fewer than 3 cells per period, offsets would revisit a cell.
-                    if dk < 3 && off[k] != 0 && (dk == 1 || off[k] == 1) {
-                        valid = false;
-                        break;
-                    }
-                    i = i.rem_euclid(dk);
-                } else if i < 0 || i >= dk {
-                    valid = false;
-                    break;
-                }
-                id = id * self.dims[k] + i as usize;
-            }
-            if valid {
+        loop {
+            let id = (0..D)
+                .rev()
+                .try_fold(0usize, |id, k| Some(id * self.dims[k] + self.axis_cell(k, base[k], off[k])?));
+            if let Some(id) = id {
                 let (s, e) = (self.cell_start[id] as usize, self.cell_start[id + 1] as usize);
                 for &j in &self.sorted[s..e] {
                     f(j);
                 }
             }
-            let mut k = 0;
-            loop {
-                if k == D {
-                    break 'cells;
-                }
-                off[k] += 1;
-                if off[k] <= 1 {
-                    break;
-                }
-                off[k] = -1;
-                k += 1;
+            if !next_offset(&mut off, 0) {
+                return;
             }
         }
     }
+
+    /// Index on axis `k` of the cell `base + off` (wrapped on a periodic axis), or `None`
+    /// outside the grid, or where a periodic axis has fewer than 3 cells and the offset
+    /// would revisit a cell.
+    #[inline(always)]
+    fn axis_cell(&self, k: usize, base: isize, off: isize) -> Option<usize> {
+        let dk = self.dims[k] as isize;
+        let i = base + off;
+        if self.domain.periodic[k].is_some() {
+            if dk < 3 && off != 0 && (dk == 1 || off == 1) {
+                return None;
+            }
+            Some(i.rem_euclid(dk) as usize)
+        } else if (0..dk).contains(&i) {
+            Some(i as usize)
+        } else {
+            None
+        }
+    }
+}
+
+/// Advances the cell offsets `off[from..]` through {−1, 0, 1}^(D−from), axis `from`
+/// fastest (an odometer); false once every combination was visited.
+#[inline(always)]
+fn next_offset<const D: usize>(off: &mut [isize; D], from: usize) -> bool {
+    for o in &mut off[from..] {
+        *o += 1;
+        if *o <= 1 {
+            return true;
+        }
+        *o = -1;
+    }
+    false
 }
 
 #[cfg(test)]
