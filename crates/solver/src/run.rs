@@ -542,6 +542,10 @@ impl<const D: usize> Simulation<D> {
         let counted = list.len() >= p.len();
         let limit = self.neighbour_band.limit;
         let support = self.support;
+        // Two fluid particles approach at most at twice the largest speed: when even that
+        // cannot cover the support in one step (always at the start of an adaptive step,
+        // cfl ≤ 1), the pair scan for an overstep is skipped.
+        let scan_pairs = 2.0 * self.state.max_speed() * dt > support;
         // Severity of particle a's failure (0 = none), most severe first.
         let severity = |a: usize| -> u8 {
             if !p.x[a].iter().all(|v| v.is_finite()) {
@@ -552,7 +556,8 @@ impl<const D: usize> Simulation<D> {
                 4
             } else if (0..D).any(|k| p.x[a][k] < lo[k] || p.x[a][k] > hi[k]) {
                 3
-            } else if a < list.len()
+            } else if scan_pairs
+                && a < list.len()
                 && list.of(a).iter().any(|&b| {
                     (b as usize) < p.len()
                         && (p.u[a] - p.u[b as usize]).norm_squared() * dt * dt > support * support
