@@ -12,7 +12,6 @@
 use super::Outcome;
 use crate::case::{Case, Tier};
 use crate::error::{HarnessError, Result};
-use crate::metrics;
 use meniscus::Scene;
 use meniscus::scene::schema::{PpeSolver, Scheme, Shifting, ViscousIntegration};
 use serde::{Deserialize, Serialize};
@@ -296,45 +295,26 @@ impl ChannelStudy {
 
 /// The row of a planned run from its outcome.
 pub fn row(case: &Case, planned: &ChannelPlanned, scene: &Scene, outcome: Outcome) -> Result<ChannelRow> {
-    let mut row = ChannelRow {
-        id: planned.id(),
+    let (id, cpu_s) = (planned.id(), outcome.cpu_s);
+    let m = super::measure(case, scene, outcome)?;
+    let get = |k: &str| m.metrics.get(k).copied();
+    Ok(ChannelRow {
         dx: planned.dx,
         variant: planned.variant,
         preset: planned.variant.preset().map(str::to_string),
         threads: planned.threads,
-        particles: 0,
-        steps: 0,
-        t_end: 0.0,
-        wall_s: 0.0,
-        cpu_s: outcome.cpu_s,
-        stages: BTreeMap::new(),
-        ppe_iterations_mean: 0.0,
-        error: None,
-        error_startup_max: None,
-        status: "ok".into(),
-    };
-    let report = match outcome.report {
-        Ok(report) => report,
-        Err(msg) => {
-            row.status = format!("diverged: the solver panicked: {msg}");
-            return Ok(row);
-        }
-    };
-    let s = &report.summary;
-    (row.particles, row.steps, row.t_end, row.wall_s) = (s.particles, s.steps, s.t_end, s.wall_s);
-    row.stages = s.stages.clone();
-    row.ppe_iterations_mean = s.ppe_iterations_mean;
-    if let Some(e) = &report.error {
-        row.status = format!("diverged: {e}");
-        return Ok(row);
-    }
-    let scene_json = serde_json::to_value(scene).unwrap_or_default();
-    let measured = metrics::compute(&case.reference, &scene_json, &report.probes, s.particles)
-        .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
-    let get = |k: &str| measured.metrics.get(k).copied().filter(|v| v.is_finite());
-    row.error = get(METRIC);
-    row.error_startup_max = get("u_profile_l2_rel_startup_max");
-    Ok(row)
+        particles: m.particles,
+        steps: m.steps,
+        t_end: m.t_end,
+        wall_s: m.wall_s,
+        cpu_s,
+        error: get(METRIC),
+        error_startup_max: get("u_profile_l2_rel_startup_max"),
+        stages: m.stages,
+        ppe_iterations_mean: m.ppe_iterations_mean,
+        status: m.status,
+        id,
+    })
 }
 
 #[cfg(test)]

@@ -217,51 +217,76 @@ fn execute(case: &Case, planned: &Planned, pool: &rayon::ThreadPool) -> Result<R
         run: id.clone(),
         source,
     })?;
-    let mut row = RunRow {
-        id,
+    let cpu_s = outcome.cpu_s;
+    let m = measure(case, &scene, outcome)?;
+    let get = |k: &str| m.metrics.get(k).copied();
+    Ok(RunRow {
         dx: planned.dx,
         variant: planned.variant,
         preset: planned.variant.preset().map(str::to_string),
         threads: planned.threads,
         groups: planned.groups.clone(),
+        particles: m.particles,
+        steps: m.steps,
+        t_end: m.t_end,
+        wall_s: m.wall_s,
+        cpu_s,
+        b_err: get("b_rel_err_final"),
+        b_err_max: get("b_rel_err_max"),
+        a_err: get("a_rel_err_final"),
+        stages: m.stages,
+        ppe_iterations_mean: m.ppe_iterations_mean,
+        status: m.status,
+        id,
+    })
+}
+
+/// What a work-precision row takes from a run: its size and cost, its status, and the
+/// case's finite metrics when it reached its end time (none after a divergence).
+pub(crate) struct Measured {
+    pub particles: usize,
+    pub steps: usize,
+    pub t_end: f64,
+    pub wall_s: f64,
+    pub stages: std::collections::BTreeMap<String, f64>,
+    pub ppe_iterations_mean: f64,
+    pub status: String,
+    pub metrics: std::collections::BTreeMap<String, f64>,
+}
+
+/// Reads the `outcome` of a run of `scene`: a panic or a divergence becomes the status
+/// (`diverged: …`), a finished run gets the metrics of `case`'s reference.
+pub(crate) fn measure(case: &Case, scene: &meniscus::Scene, outcome: Outcome) -> Result<Measured> {
+    let mut m = Measured {
         particles: 0,
         steps: 0,
         t_end: 0.0,
         wall_s: 0.0,
-        cpu_s: outcome.cpu_s,
         stages: Default::default(),
         ppe_iterations_mean: 0.0,
-        b_err: None,
-        b_err_max: None,
-        a_err: None,
         status: "ok".into(),
+        metrics: Default::default(),
     };
     let report = match outcome.report {
         Ok(report) => report,
         Err(msg) => {
-            row.status = format!("diverged: the solver panicked: {msg}");
-            return Ok(row);
+            m.status = format!("diverged: the solver panicked: {msg}");
+            return Ok(m);
         }
     };
     let s = &report.summary;
-    row.particles = s.particles;
-    row.steps = s.steps;
-    row.t_end = s.t_end;
-    row.wall_s = s.wall_s;
-    row.stages = s.stages.clone();
-    row.ppe_iterations_mean = s.ppe_iterations_mean;
+    (m.particles, m.steps, m.t_end, m.wall_s) = (s.particles, s.steps, s.t_end, s.wall_s);
+    m.stages = s.stages.clone();
+    m.ppe_iterations_mean = s.ppe_iterations_mean;
     if let Some(e) = &report.error {
-        row.status = format!("diverged: {e}");
-        return Ok(row);
+        m.status = format!("diverged: {e}");
+        return Ok(m);
     }
-    let scene_json = serde_json::to_value(&scene).unwrap_or_default();
+    let scene_json = serde_json::to_value(scene).unwrap_or_default();
     let measured = metrics::compute(&case.reference, &scene_json, &report.probes, s.particles)
         .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
-    let get = |k: &str| measured.metrics.get(k).copied().filter(|v| v.is_finite());
-    row.b_err = get("b_rel_err_final");
-    row.b_err_max = get("b_rel_err_max");
-    row.a_err = get("a_rel_err_final");
-    Ok(row)
+    m.metrics = measured.metrics.into_iter().filter(|(_, v)| v.is_finite()).collect();
+    Ok(m)
 }
 
 /// The runs shown in the stage breakdown: the presets at every spacing, and the PPE
