@@ -35,19 +35,13 @@ fn run_row(r: &RunRow, front: bool) -> Markup {
         tr class=(if front { "front" } else { "" }) {
             td class="l" { code { (r.id) } }
             td { (r.dx) }
-            td class="l" { (serde_json::to_value(r.variant.ppe).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()) }
+            td class="l" { (snake(r.variant.ppe)) }
             td class="l" { (format!("{:?}", r.variant.gradient).to_lowercase()) }
             td class="l" { (format!("{:?}", r.variant.divergence).to_lowercase()) }
             td class="l" { (format!("{:?}", r.variant.shifting).to_lowercase()) }
             td class="l" { (format!("{:?}", r.variant.dt).to_lowercase()) }
             td class="l" { (r.preset.as_deref().unwrap_or("")) }
-            td { (r.threads) }
-            td { (r.particles) }
-            td { (r.steps) }
-            td { (format!("{:.3}", r.wall_s)) }
-            td { (r.cpu_s.map_or("—".into(), |c| format!("{:.2}", c / r.wall_s.max(1e-12)))) }
-            td { (ms) }
-            td { (format!("{:.1}", r.ppe_iterations_mean)) }
+            (cost_cells(r.threads, r.particles, r.steps, r.wall_s, r.cpu_s, &ms, r.ppe_iterations_mean))
             td { (pct(r.b_err)) }
             td { (pct(r.b_err_max)) }
             td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
@@ -55,6 +49,29 @@ fn run_row(r: &RunRow, front: bool) -> Markup {
     }
 }
 
+/// The cells both studies' rows share: threads, particles, steps, wall time \[s\], CPU/wall,
+/// `ms` per step (formatted by the caller) and mean PPE iterations.
+fn cost_cells(
+    threads: usize,
+    particles: usize,
+    steps: usize,
+    wall_s: f64,
+    cpu_s: Option<f64>,
+    ms: &str,
+    ppe_iterations: f64,
+) -> Markup {
+    html! {
+        td { (threads) }
+        td { (particles) }
+        td { (steps) }
+        td { (format!("{wall_s:.3}")) }
+        td { (cpu_s.map_or("—".into(), |c| format!("{:.2}", c / wall_s.max(1e-12)))) }
+        td { (ms) }
+        td { (format!("{ppe_iterations:.1}")) }
+    }
+}
+
+/// A serde enum value as its snake_case name.
 fn snake<T: serde::Serialize>(v: T) -> String {
     serde_json::to_value(v).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()
 }
@@ -69,13 +86,7 @@ fn channel_row(r: &ChannelRow, front: bool) -> Markup {
             td class="l" { (snake(r.variant.shifting)) }
             td class="l" { (snake(r.variant.ppe)) }
             td class="l" { (r.preset.as_deref().unwrap_or("")) }
-            td { (r.threads) }
-            td { (r.particles) }
-            td { (r.steps) }
-            td { (format!("{:.3}", r.wall_s)) }
-            td { (r.cpu_s.map_or("—".into(), |c| format!("{:.2}", c / r.wall_s.max(1e-12)))) }
-            td { (ms) }
-            td { (format!("{:.1}", r.ppe_iterations_mean)) }
+            (cost_cells(r.threads, r.particles, r.steps, r.wall_s, r.cpu_s, &ms, r.ppe_iterations_mean))
             td { (pct(r.error)) }
             td { (pct(r.error_startup_max)) }
             td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
