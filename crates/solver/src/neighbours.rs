@@ -257,12 +257,21 @@ impl<const D: usize> CellSearch<D> {
                 for (k, count) in counts.iter_mut().enumerate() {
                     let a = c * CHUNK + k;
                     let before = rows.len();
-                    this.visit_candidates(&x[a], |b| {
-                        if b as usize != a
-                            && this.domain.displacement(&x[a], &x[b as usize]).norm_squared() < r2
-                        {
-                            rows.push(b);
+                    // Copy each run of candidates, then keep the neighbours by a
+                    // branch-free compaction in place: whether a candidate is within the
+                    // radius is random from one to the next (about a third are), and a
+                    // mispredicted branch per candidate cost more than the copy.
+                    this.visit_candidates(&x[a], |run| {
+                        let start = rows.len();
+                        rows.extend_from_slice(run);
+                        let mut kept = start;
+                        for i in start..rows.len() {
+                            let b = rows[i];
+                            let d2 = this.domain.displacement(&x[a], &x[b as usize]).norm_squared();
+                            rows[kept] = b;
+                            kept += usize::from((d2 < r2) & (b as usize != a));
                         }
+                        rows.truncate(kept);
                     });
                     *count = rows.len() - before;
                 }
@@ -278,15 +287,15 @@ impl<const D: usize> CellSearch<D> {
         self.chunk_rows = chunk_rows;
     }
 
-    /// Calls `f` with every particle in the 3^D cells around `p` (each particle once), in
-    /// the order of [`Self::visit_cells`].
+    /// Calls `f` with runs of `sorted` that together hold every particle in the 3^D cells
+    /// around `p` (each particle once), in the order of [`Self::visit_cells`].
     ///
     /// Axis 0 varies fastest in the cell id, so the (up to) three cells of one row around
     /// `p` are consecutive ids and their particles one contiguous run of `sorted`: one
     /// range per row of cells (3^(D−1) ranges) instead of one per cell. A row that wraps
     /// around a periodic axis 0 is not contiguous and goes cell by cell.
     #[inline]
-    fn visit_candidates(&self, p: &SVector<f64, D>, mut f: impl FnMut(u32)) {
+    fn visit_candidates(&self, p: &SVector<f64, D>, mut f: impl FnMut(&[u32])) {
         let base = self.cell_index(p);
         let d0 = self.dims[0] as isize;
         let (lo0, hi0) = if self.domain.periodic[0].is_some() {
@@ -308,9 +317,7 @@ impl<const D: usize> CellSearch<D> {
                     self.cell_start[first + lo0 as usize] as usize,
                     self.cell_start[first + hi0 as usize + 1] as usize,
                 );
-                for &j in &self.sorted[s..e] {
-                    f(j);
-                }
+                f(&self.sorted[s..e]);
             }
             if !next_offset(&mut off, 1) {
                 return;
@@ -329,9 +336,9 @@ impl<const D: usize> CellSearch<D> {
         base
     }
 
-    /// Calls `f` with every particle in the 3^D cells around the cell `base`, cell by cell
-    /// (axis 0 fastest; each cell once, also when a periodic axis has fewer than 3 cells).
-    fn visit_cells(&self, base: &[isize; D], mut f: impl FnMut(u32)) {
+    /// Calls `f` with the particles of each of the 3^D cells around the cell `base`, cell by
+    /// cell (axis 0 fastest; each cell once, also when a periodic axis has fewer than 3 cells).
+    fn visit_cells(&self, base: &[isize; D], mut f: impl FnMut(&[u32])) {
         let mut off = [-1isize; D];
         loop {
             let id = (0..D)
@@ -339,9 +346,7 @@ impl<const D: usize> CellSearch<D> {
                 .try_fold(0usize, |id, k| Some(id * self.dims[k] + self.axis_cell(k, base[k], off[k])?));
             if let Some(id) = id {
                 let (s, e) = (self.cell_start[id] as usize, self.cell_start[id + 1] as usize);
-                for &j in &self.sorted[s..e] {
-                    f(j);
-                }
+                f(&self.sorted[s..e]);
             }
             if !next_offset(&mut off, 0) {
                 return;
@@ -446,9 +451,11 @@ mod tests {
             search.build(&x, &mut list);
             for (a, xa) in x.iter().enumerate() {
                 let mut want = Vec::new();
-                search.visit_cells(&search.cell_index(xa), |b| {
-                    if b as usize != a && dom.displacement(xa, &x[b as usize]).norm_squared() < r * r {
-                        want.push(b);
+                search.visit_cells(&search.cell_index(xa), |cell| {
+                    for &b in cell {
+                        if b as usize != a && dom.displacement(xa, &x[b as usize]).norm_squared() < r * r {
+                            want.push(b);
+                        }
                     }
                 });
                 assert_eq!(list.of(a), &want[..], "particle {a}");
