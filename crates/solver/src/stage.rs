@@ -49,3 +49,38 @@ pub fn par_rows_mut<T: Send, F: Fn(usize, &mut [T]) + Sync>(offsets: &[usize], d
         rec(0, n, offsets, data, f);
     }
 }
+
+/// [`par_rows_mut`] over two arrays with the same row layout (the columns and the values of
+/// a compressed sparse row matrix): `f(a, &mut xs[row a], &mut ys[row a])`.
+pub fn par_rows_mut2<X: Send, Y: Send, F: Fn(usize, &mut [X], &mut [Y]) + Sync>(
+    offsets: &[usize],
+    xs: &mut [X],
+    ys: &mut [Y],
+    f: &F,
+) {
+    fn rec<X: Send, Y: Send, F: Fn(usize, &mut [X], &mut [Y]) + Sync>(
+        lo: usize,
+        hi: usize,
+        offsets: &[usize],
+        xs: &mut [X],
+        ys: &mut [Y],
+        f: &F,
+    ) {
+        if hi - lo <= 256 {
+            let base = offsets[lo];
+            for a in lo..hi {
+                let (s, e) = (offsets[a] - base, offsets[a + 1] - base);
+                f(a, &mut xs[s..e], &mut ys[s..e]);
+            }
+        } else {
+            let mid = lo + (hi - lo) / 2;
+            let (xl, xr) = xs.split_at_mut(offsets[mid] - offsets[lo]);
+            let (yl, yr) = ys.split_at_mut(offsets[mid] - offsets[lo]);
+            rayon::join(|| rec(lo, mid, offsets, xl, yl, f), || rec(mid, hi, offsets, xr, yr, f));
+        }
+    }
+    let n = offsets.len().saturating_sub(1);
+    if n > 0 {
+        rec(0, n, offsets, xs, ys, f);
+    }
+}

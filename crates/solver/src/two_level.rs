@@ -50,7 +50,7 @@ impl<'a> TwoLevel<'a> {
                 continue;
             }
             aggregate[i] = count;
-            for &(j, _) in &a.entries[a.row_ptr[i]..a.row_ptr[i + 1]] {
+            for &j in &a.cols[a.row_ptr[i]..a.row_ptr[i + 1]] {
                 if aggregate[j as usize] == u32::MAX {
                     aggregate[j as usize] = count;
                 }
@@ -79,7 +79,7 @@ impl<'a> TwoLevel<'a> {
         for g in 0..nc {
             for &i in &members[start[g]..start[g + 1]] {
                 let i = i as usize;
-                for &(j, v) in &a.entries[a.row_ptr[i]..a.row_ptr[i + 1]] {
+                for (j, v) in a.row(i) {
                     let h = aggregate[j as usize];
                     if mark[h as usize] != g as u32 {
                         mark[h as usize] = g as u32;

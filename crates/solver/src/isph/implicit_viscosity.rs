@@ -15,7 +15,7 @@
 use crate::error::Cause;
 use crate::ppe::{PpeMatrix, PpeSolve};
 use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
-use crate::stage::{Stage, StepContext, par_rows_mut};
+use crate::stage::{Stage, StepContext, par_rows_mut2};
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -79,8 +79,8 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
         for a in 0..n {
             m.row_ptr[a + 1] += m.row_ptr[a];
         }
-        m.entries.resize(m.row_ptr[n], (0, 0.0));
-        par_rows_mut(&m.row_ptr, &mut m.entries, &|a, row: &mut [(u32, f64)]| {
+        m.resize_entries();
+        par_rows_mut2(&m.row_ptr, &mut m.cols, &mut m.vals, &|a, cols: &mut [u32], vals: &mut [f64]| {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let mut diag = 1.0;
             let mut k = 1;
@@ -91,21 +91,21 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
                 match column(b as usize) {
                     Some((col, f)) if col as usize == a => diag -= w * f,
                     Some((col, f)) => {
-                        row[k] = (col, -w * f);
+                        (cols[k], vals[k]) = (col, -w * f);
                         k += 1;
                     }
                     None => {}
                 }
             }
-            row[0] = (a as u32, diag);
+            (cols[0], vals[0]) = (a as u32, diag);
         });
         m.inv_diag.resize(n, 0.0);
-        let (entries, row_ptr) = (&m.entries, &m.row_ptr);
+        let (vals, row_ptr) = (&m.vals, &m.row_ptr);
         m.inv_diag
             .par_iter_mut()
             .enumerate()
             .with_min_len(512)
-            .for_each(|(a, d)| *d = 1.0 / entries[row_ptr[a]].1);
+            .for_each(|(a, d)| *d = 1.0 / vals[row_ptr[a]]);
         let (u_old, u) = (&s.u_old, &mut s.particles.u);
         for k in 0..D {
             self.rhs.resize(n, 0.0);

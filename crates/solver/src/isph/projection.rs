@@ -4,7 +4,7 @@
 use crate::error::Cause;
 use crate::ppe::PpeSolve;
 use crate::scene::{Divergence, PressureGradient};
-use crate::stage::{Stage, StepContext, par_rows_mut};
+use crate::stage::{Stage, StepContext, par_rows_mut2};
 use crate::state::{State, Vector};
 use nalgebra::SMatrix;
 use rayon::prelude::*;
@@ -95,11 +95,11 @@ impl<const D: usize> Stage<D> for PpeAssemble {
         for i in 0..rows {
             m.row_ptr[i + 1] += m.row_ptr[i];
         }
-        m.entries.resize(m.row_ptr[rows], (0, 0.0));
+        m.resize_entries();
         m.inv_diag.resize(rows, 0.0);
         let (v, rho, eta2) = (s.volume, s.density, 0.01 * s.h * s.h);
         let pairs = &s.pairs;
-        par_rows_mut(&m.row_ptr, &mut m.entries, &|i, row: &mut [(u32, f64)]| {
+        par_rows_mut2(&m.row_ptr, &mut m.cols, &mut m.vals, &|i, cols: &mut [u32], vals: &mut [f64]| {
             let a = particle_of[i] as usize;
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let mut diag = 0.0;
@@ -113,16 +113,15 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                 let c = -2.0 * v * p.f * p.r2 / (rho * (p.r2 + eta2));
                 diag += c;
                 if rb != u32::MAX {
-                    row[k] = (rb, -c);
+                    (cols[k], vals[k]) = (rb, -c);
                     k += 1;
                 }
             }
-            row[0] = (i as u32, diag);
+            (cols[0], vals[0]) = (i as u32, diag);
         });
-        let entries = &m.entries;
-        let row_ptr = &m.row_ptr;
+        let (vals, row_ptr) = (&m.vals, &m.row_ptr);
         m.inv_diag.par_iter_mut().enumerate().with_min_len(512).for_each(|(i, d)| {
-            *d = 1.0 / entries[row_ptr[i]].1;
+            *d = 1.0 / vals[row_ptr[i]];
         });
         sys.rhs.resize(rows, 0.0);
         let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
