@@ -13,6 +13,7 @@
 pub mod error;
 pub mod isph;
 pub mod kernel;
+pub mod krylov;
 pub mod neighbours;
 pub mod ppe;
 pub mod probes;

@@ -8,21 +8,17 @@
 //! per step. [`PpeMatrix::to_triplets`] gives the triplet form for the direct solver and
 //! for tests that check the fast assembly against faer's triplet assembly.
 //!
-//! Krylov solvers are faer's (`matrix_free::conjugate_gradient`, `matrix_free::bicgstab`)
-//! with a Jacobi preconditioner; the direct solver is faer's sparse LU. The operator is
-//! applied row-parallel (each row written by one task), and faer's vector operations run
-//! with `Par::Seq`, so the result does not depend on the thread count.
+//! The Krylov solvers (Jacobi-preconditioned CG and BiCGSTAB) are [`crate::krylov`]'s,
+//! whose parallel vector operations give the same bits for any thread count; the direct
+//! solver is faer's sparse LU. The operator is applied row-parallel (each row written by
+//! one task).
 
 use crate::error::Cause;
-use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
+use crate::krylov::{self, KrylovError, KrylovParams, Preconditioner, Workspace};
+use crate::scene::{PpeOptions, PpeSolver, Preconditioner as PreconditionerKind};
 use crate::two_level::TwoLevel;
-use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
-use faer::mat::{MatMut, MatRef};
-use faer::matrix_free::bicgstab::{BicgParams, bicgstab, bicgstab_scratch};
-use faer::matrix_free::conjugate_gradient::{CgParams, conjugate_gradient, conjugate_gradient_scratch};
-use faer::matrix_free::{InitialGuessStatus, LinOp, Precond};
+use faer::Mat;
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Par};
 use rayon::prelude::*;
 
 /// Sparse PPE matrix in compressed sparse rows, with its inverse diagonal (Jacobi).
@@ -89,60 +85,18 @@ impl PpeMatrix {
     }
 }
 
-impl LinOp<f64> for PpeMatrix {
-    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
-        StackReq::EMPTY
-    }
-    fn nrows(&self) -> usize {
-        self.n()
-    }
-    fn ncols(&self) -> usize {
-        self.n()
-    }
-    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
-        for j in 0..rhs.ncols() {
-            let x = rhs.col(j).try_as_col_major().expect("faer columns are contiguous");
-            let y = out.as_mut().col_mut(j).try_as_col_major_mut().expect("faer columns are contiguous");
-            self.mul(x.as_slice(), y.as_slice_mut());
-        }
-    }
-    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
-        self.apply(out, rhs, par, stack);
-    }
-}
-
 /// Jacobi preconditioner `M⁻¹ = diag(A)⁻¹`.
 #[derive(Debug, Clone, Copy)]
 struct Jacobi<'a>(&'a [f64]);
 
-impl LinOp<f64> for Jacobi<'_> {
-    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
-        StackReq::EMPTY
-    }
-    fn nrows(&self) -> usize {
-        self.0.len()
-    }
-    fn ncols(&self) -> usize {
-        self.0.len()
-    }
-    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
-        for j in 0..rhs.ncols() {
-            let x = rhs.col(j).try_as_col_major().expect("faer columns are contiguous");
-            let y = out.as_mut().col_mut(j).try_as_col_major_mut().expect("faer columns are contiguous");
-            // Element-wise, so the parallel result is the serial one.
-            y.as_slice_mut().par_iter_mut().zip(x.as_slice()).zip(self.0).with_min_len(4096).for_each(
-                |((yi, xi), di)| {
-                    *yi = di * xi;
-                },
-            );
-        }
-    }
-    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
-        self.apply(out, rhs, par, stack);
+impl Preconditioner for Jacobi<'_> {
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
+        // Element-wise, so the parallel result is the serial one.
+        z.par_iter_mut().zip(r).zip(self.0).with_min_len(krylov::BLOCK).for_each(|((zi, ri), di)| {
+            *zi = di * ri;
+        });
     }
 }
-
-impl Precond<f64> for Jacobi<'_> {}
 
 /// What a solve did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
@@ -154,24 +108,19 @@ pub struct PpeInfo {
 }
 
 /// A PPE solver with reusable workspace.
+#[derive(Debug)]
 pub struct PpeSolve {
     opts: PpeOptions,
-    x: Mat<f64>,
-    b: Mat<f64>,
+    x: Vec<f64>,
+    b: Vec<f64>,
     r: Vec<f64>,
-    buf: Option<(usize, MemBuffer)>,
-}
-
-impl std::fmt::Debug for PpeSolve {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("PpeSolve").field("opts", &self.opts).field("n", &self.x.nrows()).finish()
-    }
+    workspace: Workspace,
 }
 
 impl PpeSolve {
     /// A solver configured by the scene's `scheme.isph.ppe` options.
     pub fn new(opts: PpeOptions) -> Self {
-        Self { opts, x: Mat::zeros(0, 1), b: Mat::zeros(0, 1), r: Vec::new(), buf: None }
+        Self { opts, x: Vec::new(), b: Vec::new(), r: Vec::new(), workspace: Workspace::default() }
     }
 
     /// Name of the configured solver.
@@ -199,16 +148,12 @@ impl PpeSolve {
         if n == 0 {
             return Ok(PpeInfo::default());
         }
-        if self.x.nrows() != n {
-            self.x = Mat::zeros(n, 1);
-            self.b = Mat::zeros(n, 1);
-        }
         let mean_b = if singular { b.iter().sum::<f64>() / n as f64 } else { 0.0 };
-        for i in 0..n {
-            self.b[(i, 0)] = b[i] - mean_b;
-            self.x[(i, 0)] = p[i];
-        }
-        let bnorm = self.b.norm_l2();
+        self.b.clear();
+        self.b.extend(b.iter().map(|bi| bi - mean_b));
+        self.x.clear();
+        self.x.extend_from_slice(p);
+        let bnorm = self.b.iter().map(|v| v * v).sum::<f64>().sqrt();
         if bnorm == 0.0 {
             p.iter_mut().for_each(|v| *v = 0.0);
             return Ok(PpeInfo::default());
@@ -218,9 +163,9 @@ impl PpeSolve {
             PpeSolver::Bicgstab => self.krylov(a, false, singular)?,
             PpeSolver::Direct => self.direct(a, singular)?,
         };
-        let mean_x = if singular { (0..n).map(|i| self.x[(i, 0)]).sum::<f64>() / n as f64 } else { 0.0 };
-        for (i, pi) in p.iter_mut().enumerate() {
-            *pi = self.x[(i, 0)] - mean_x;
+        let mean_x = if singular { self.x.iter().sum::<f64>() / n as f64 } else { 0.0 };
+        for (pi, xi) in p.iter_mut().zip(&self.x) {
+            *pi = xi - mean_x;
         }
         // The residual as measured here, whatever the solver's internal norm.
         self.r.resize(n, 0.0);
@@ -229,88 +174,36 @@ impl PpeSolve {
         Ok(PpeInfo { iterations: info.iterations, residual: res })
     }
 
-    fn workspace(&mut self, req: StackReq) -> &mut MemStack {
-        let need = req.size_bytes();
-        if self.buf.as_ref().is_none_or(|(have, _)| *have < need) {
-            self.buf = Some((need, MemBuffer::new(req)));
-        }
-        MemStack::new(&mut self.buf.as_mut().expect("allocated above").1)
-    }
-
     fn krylov(&mut self, a: &PpeMatrix, cg: bool, singular: bool) -> Result<PpeInfo, Cause> {
         let two_level = match self.opts.preconditioner {
-            Preconditioner::TwoLevel if !singular => TwoLevel::new(a),
+            PreconditionerKind::TwoLevel if !singular => TwoLevel::new(a),
             _ => None,
         };
         match two_level {
             Some(m) => self.krylov_with(a, &m, cg),
-            None => self.krylov_with(a, Jacobi(&a.inv_diag), cg),
+            None => self.krylov_with(a, &Jacobi(&a.inv_diag), cg),
         }
     }
 
-    fn krylov_with<M: Precond<f64> + Copy>(
-        &mut self,
-        a: &PpeMatrix,
-        m: M,
-        cg: bool,
-    ) -> Result<PpeInfo, Cause> {
-        let (tol, max_iters) = (self.opts.tolerance, self.opts.max_iterations);
-        let name = self.name();
-        let mut x = std::mem::replace(&mut self.x, Mat::zeros(0, 1));
-        let b = std::mem::replace(&mut self.b, Mat::zeros(0, 1));
+    fn krylov_with(&mut self, a: &PpeMatrix, m: &impl Preconditioner, cg: bool) -> Result<PpeInfo, Cause> {
+        let params =
+            KrylovParams { tolerance: self.opts.tolerance, max_iterations: self.opts.max_iterations };
+        let (b, x, ws) = (&self.b, &mut self.x, &mut self.workspace);
         let result = if cg {
-            let req = conjugate_gradient_scratch(m, a, 1, Par::Seq);
-            let stack = self.workspace(req);
-            let params = CgParams::<f64> {
-                initial_guess: InitialGuessStatus::MaybeNonZero,
-                rel_tolerance: tol,
-                abs_tolerance: 0.0,
-                max_iters,
-                ..Default::default()
-            };
-            conjugate_gradient(x.as_mut(), m, a, b.as_ref(), params, |_| {}, Par::Seq, stack)
-                .map(|i| PpeInfo { iterations: i.iter_count, residual: i.rel_residual })
-                .map_err(|e| match e {
-                    faer::matrix_free::conjugate_gradient::CgError::NoConvergence {
-                        rel_residual, ..
-                    } => Cause::PpeNoConvergence {
-                        solver: name,
-                        residual: rel_residual,
-                        iterations: max_iters,
-                    },
-                    other => Cause::PpeBreakdown { solver: name, reason: format!("{other:?}") },
-                })
+            krylov::conjugate_gradient(a, m, b, x, params, ws)
         } else {
-            let req = bicgstab_scratch(m, faer::matrix_free::IdentityPrecond { dim: a.n() }, a, 1, Par::Seq);
-            let stack = self.workspace(req);
-            let params = BicgParams::<f64> {
-                initial_guess: InitialGuessStatus::MaybeNonZero,
-                rel_tolerance: tol,
-                abs_tolerance: 0.0,
-                max_iters,
-                ..Default::default()
-            };
-            bicgstab(
-                x.as_mut(),
-                m,
-                faer::matrix_free::IdentityPrecond { dim: a.n() },
-                a,
-                b.as_ref(),
-                params,
-                |_| {},
-                Par::Seq,
-                stack,
-            )
-            .map(|i| PpeInfo { iterations: i.iter_count, residual: i.rel_residual })
-            .map_err(|e| match e {
-                faer::matrix_free::bicgstab::BicgError::NoConvergence { rel_residual, .. } => {
-                    Cause::PpeNoConvergence { solver: name, residual: rel_residual, iterations: max_iters }
-                }
-            })
+            krylov::bicgstab(a, m, b, x, params, ws)
         };
-        self.x = x;
-        self.b = b;
-        result
+        let solver = self.name();
+        match result {
+            Ok(iterations) => Ok(PpeInfo { iterations, residual: 0.0 }),
+            Err(KrylovError::NoConvergence { residual }) => {
+                Err(Cause::PpeNoConvergence { solver, residual, iterations: params.max_iterations })
+            }
+            Err(KrylovError::Breakdown { what }) => {
+                Err(Cause::PpeBreakdown { solver, reason: format!("{what} is zero or not finite") })
+            }
+        }
     }
 
     fn direct(&mut self, a: &PpeMatrix, singular: bool) -> Result<PpeInfo, Cause> {
@@ -320,14 +213,17 @@ impl PpeSolve {
             // Pin p_0 = 0 (the mean is fixed afterwards): replace row 0 by the identity.
             trip.retain(|t| t.row != 0);
             trip.push(Triplet::new(0, 0, 1.0));
-            self.b[(0, 0)] = 0.0;
+            self.b[0] = 0.0;
         }
         let m = SparseColMat::<usize, f64>::try_new_from_triplets(n, n, &trip)
             .map_err(|e| Cause::PpeBreakdown { solver: "direct", reason: format!("{e:?}") })?;
         let lu = m.sp_lu().map_err(|e| Cause::PpeBreakdown { solver: "direct", reason: format!("{e:?}") })?;
         use faer::linalg::solvers::SolveCore;
-        self.x.copy_from(&self.b);
-        lu.solve_in_place_with_conj(faer::Conj::No, self.x.as_mut());
+        let mut x = Mat::<f64>::from_fn(n, 1, |i, _| self.b[i]);
+        lu.solve_in_place_with_conj(faer::Conj::No, x.as_mut());
+        for (xi, i) in self.x.iter_mut().zip(0..n) {
+            *xi = x[(i, 0)];
+        }
         Ok(PpeInfo { iterations: 0, residual: 0.0 })
     }
 }
@@ -382,8 +278,8 @@ mod tests {
             (p, info.iterations)
         };
         for solver in [PpeSolver::Cg, PpeSolver::Bicgstab] {
-            let (pj, jacobi) = solve(Preconditioner::Jacobi, solver);
-            let (pt, two) = solve(Preconditioner::TwoLevel, solver);
+            let (pj, jacobi) = solve(PreconditionerKind::Jacobi, solver);
+            let (pt, two) = solve(PreconditionerKind::TwoLevel, solver);
             let err = pj.iter().zip(&pt).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
             let scale = pj.iter().map(|x| x.abs()).fold(0.0, f64::max);
             assert!(err < 1e-7 * scale, "{solver:?}: {err} vs {scale}");
@@ -403,7 +299,7 @@ mod tests {
                 solver,
                 tolerance: 1e-10,
                 max_iterations: 1000,
-                preconditioner: Preconditioner::Jacobi,
+                preconditioner: PreconditionerKind::Jacobi,
             });
             let mut p = vec![0.0; n];
             let info = s.solve(&a, &b, &mut p, false).unwrap();
@@ -435,7 +331,7 @@ mod tests {
             solver: PpeSolver::Cg,
             tolerance: 1e-12,
             max_iterations: 3,
-            preconditioner: Preconditioner::Jacobi,
+            preconditioner: PreconditionerKind::Jacobi,
         });
         let mut p = vec![0.0; a.n()];
         assert!(matches!(s.solve(&a, &b, &mut p, false), Err(Cause::PpeNoConvergence { .. })));
@@ -459,7 +355,7 @@ mod tests {
                 solver,
                 tolerance: 1e-10,
                 max_iterations: 2000,
-                preconditioner: Preconditioner::Jacobi,
+                preconditioner: PreconditionerKind::Jacobi,
             });
             let mut p = vec![0.0; n];
             let info = s.solve(&a, &b, &mut p, true).unwrap();

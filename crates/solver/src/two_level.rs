@@ -14,14 +14,12 @@
 //! faer's sparse LU. faer has no incomplete factorisation or AMG, hence this small
 //! hand-written coarse space.
 
+use crate::krylov::Preconditioner;
 use crate::ppe::PpeMatrix;
-use faer::dyn_stack::{MemStack, StackReq};
+use faer::Mat;
 use faer::linalg::solvers::SolveCore;
-use faer::mat::{MatMut, MatRef};
-use faer::matrix_free::{LinOp, Precond};
 use faer::sparse::linalg::solvers::Lu;
 use faer::sparse::{SparseColMat, Triplet};
-use faer::{Mat, Par};
 use std::sync::Mutex;
 
 /// The preconditioner of one PPE matrix.
@@ -111,36 +109,16 @@ impl<'a> TwoLevel<'a> {
     }
 }
 
-impl LinOp<f64> for TwoLevel<'_> {
-    fn apply_scratch(&self, _rhs_ncols: usize, _par: Par) -> StackReq {
-        StackReq::EMPTY
-    }
-    fn nrows(&self) -> usize {
-        self.inv_diag.len()
-    }
-    fn ncols(&self) -> usize {
-        self.inv_diag.len()
-    }
-    fn apply(&self, mut out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, _par: Par, _stack: &mut MemStack) {
+impl Preconditioner for TwoLevel<'_> {
+    fn apply(&self, r: &[f64], z: &mut [f64]) {
         let mut coarse = self.coarse.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-        for j in 0..rhs.ncols() {
-            let x = rhs.col(j).try_as_col_major().expect("faer columns are contiguous");
-            coarse.fill(0.0);
-            for (xi, &g) in x.as_slice().iter().zip(&self.aggregate) {
-                coarse[(g as usize, 0)] += xi;
-            }
-            self.lu.solve_in_place_with_conj(faer::Conj::No, coarse.as_mut());
-            let y = out.as_mut().col_mut(j).try_as_col_major_mut().expect("faer columns are contiguous");
-            for (((yi, xi), di), &g) in
-                y.as_slice_mut().iter_mut().zip(x.as_slice()).zip(self.inv_diag).zip(&self.aggregate)
-            {
-                *yi = di * xi + coarse[(g as usize, 0)];
-            }
+        coarse.fill(0.0);
+        for (ri, &g) in r.iter().zip(&self.aggregate) {
+            coarse[(g as usize, 0)] += ri;
+        }
+        self.lu.solve_in_place_with_conj(faer::Conj::No, coarse.as_mut());
+        for (((zi, ri), di), &g) in z.iter_mut().zip(r).zip(self.inv_diag).zip(&self.aggregate) {
+            *zi = di * ri + coarse[(g as usize, 0)];
         }
     }
-    fn conj_apply(&self, out: MatMut<'_, f64>, rhs: MatRef<'_, f64>, par: Par, stack: &mut MemStack) {
-        self.apply(out, rhs, par, stack);
-    }
 }
-
-impl Precond<f64> for TwoLevel<'_> {}
