@@ -352,7 +352,9 @@ mod tests {
         let mut x = vec![0.0; a.n()];
         let params = KrylovParams { tolerance: 1e-12, max_iterations: 3 };
         match bicgstab(&a, &Jacobi(&a.inv_diag), &b, &mut x, params, &mut Workspace::default()) {
-            Err(KrylovError::NoConvergence { residual }) => assert!(residual > 1e-12 && residual.is_finite(), "{residual}"),
+            Err(KrylovError::NoConvergence { residual }) => {
+                assert!(residual > 1e-12 && residual.is_finite(), "{residual}")
+            }
             other => panic!("{other:?}"),
         }
     }

@@ -93,7 +93,7 @@ impl<'a> TwoLevel<'a> {
             touched.clear();
         }
         let m = SparseColMat::<usize, f64>::try_new_from_triplets(nc, nc, &triplets).ok()?;
-        let lu = m.sp_lu().ok()?;
+        let lu = crate::ppe::sparse_lu(&m).ok()?;
         // A singular coarse matrix factorises with a zero (or tiny) pivot: test it.
         let mut probe = Mat::<f64>::from_fn(nc, 1, |i, _| 1.0 + i as f64 / nc as f64);
         lu.solve_in_place_with_conj(faer::Conj::No, probe.as_mut());
