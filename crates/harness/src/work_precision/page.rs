@@ -133,7 +133,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                 p {
                     "Wall time against the relative error of the semi-axis b at t = 0.008 s (second moments, against the ellipse ODE), for "
                     (study.runs.len()) " runs of the " code { (study.case) } " scene ("
-                    (diverged) " diverged), tier " b { (study.tier) } ", " (study.threads) " threads for the main runs; the study took "
+                    (diverged) " diverged), tier " b { (study.tier) } ", " b { (m.build) } " build, " (study.threads) " threads for the main runs; the study took "
                     (format!("{:.0}", study.elapsed_s)) " s (both studies)."
                     @if !study.complete { " " b { "Incomplete: the study was interrupted." } }
                     @if study.channel.is_some() { " The periodic channel's study has its own section and figure below." }
