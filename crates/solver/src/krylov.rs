@@ -9,9 +9,17 @@
 //! so 1 and 2 threads give different bits, which breaks the determinism contract (the same
 //! scene gives bit-identical probes with any thread count). Here every reduction sums
 //! fixed blocks of [`BLOCK`] entries in parallel and adds the block sums serially in block
-//! order, so the result is the same for every thread count, and the updates that are
-//! followed by a norm or a dot product are fused with it (one pass over memory instead of
-//! two; the solve is bound by memory traffic).
+//! order, so the result is the same for every thread count.
+//!
+//! Every pass over the vectors is one parallel loop over those blocks, and the work of an
+//! iteration is fused into as few passes as the recurrence allows: a matrix product with
+//! the dot product that follows it, a vector update with its norm, and with a diagonal
+//! (Jacobi) preconditioner also with the preconditioner's application. On the 7860-row
+//! drop system a vector is 63 kB (cache resident) and a pass costs less than the fork-join
+//! that starts it, so the number of passes, not the arithmetic, sets the time: BiCGSTAB
+//! takes 5 passes per iteration instead of 10, CG 3 instead of 6. The fused passes do the
+//! same arithmetic in the same order as the separate ones, so the iterates are the same
+//! bits.
 //!
 //! Algorithms: Saad, *Iterative Methods for Sparse Linear Systems*, 2nd ed., Alg. 9.1
 //! (preconditioned CG) and van der Vorst 1992 / Barrett et al., *Templates* (1994) §2.3.8
@@ -29,6 +37,12 @@ pub const BLOCK: usize = 2048;
 pub trait Preconditioner: Sync {
     /// Writes `M⁻¹ r` into `z` (both of the system's size).
     fn apply(&self, r: &[f64], z: &mut [f64]);
+
+    /// `Some(d)` when `M⁻¹ = diag(d)`: the solvers then apply it inside their vector
+    /// passes instead of in a pass of its own (the same products, so the same bits).
+    fn diagonal(&self) -> Option<&[f64]> {
+        None
+    }
 }
 
 /// Stopping rule of a solve.
@@ -88,25 +102,8 @@ impl Workspace {
     }
 }
 
-/// `out[i] = f(i, out[i])` for every `i`, and returns `(Σ g₀, Σ g₁)` of `g(i, out[i])` (the
-/// new values), summed block by block (deterministic for any thread count).
-fn update_reduce(
-    out: &mut [f64],
-    partials: &mut [[f64; 2]],
-    f: impl Fn(usize, f64) -> f64 + Sync,
-    g: impl Fn(usize, f64) -> [f64; 2] + Sync,
-) -> [f64; 2] {
-    out.par_chunks_mut(BLOCK).zip(partials.par_iter_mut()).enumerate().for_each(|(blk, (chunk, acc))| {
-        let mut sum = [0.0; 2];
-        for (k, o) in chunk.iter_mut().enumerate() {
-            let i = blk * BLOCK + k;
-            *o = f(i, *o);
-            let [a, b] = g(i, *o);
-            sum[0] += a;
-            sum[1] += b;
-        }
-        *acc = sum;
-    });
+/// The block sums added in block order.
+fn total(partials: &[[f64; 2]]) -> [f64; 2] {
     partials.iter().fold([0.0; 2], |s, p| [s[0] + p[0], s[1] + p[1]])
 }
 
@@ -121,12 +118,89 @@ fn reduce(n: usize, partials: &mut [[f64; 2]], g: impl Fn(usize) -> [f64; 2] + S
         }
         *acc = sum;
     });
-    partials.iter().fold([0.0; 2], |s, p| [s[0] + p[0], s[1] + p[1]])
+    total(partials)
 }
 
-/// `out[i] = f(i, out[i])` in parallel.
-fn update(out: &mut [f64], f: impl Fn(usize, f64) -> f64 + Sync) {
-    out.par_iter_mut().enumerate().with_min_len(BLOCK).for_each(|(i, o)| *o = f(i, *o));
+/// One pass over the blocks: `out[i] = f(i, out[i])`, and `z[i] = d[i] out[i]` when a
+/// diagonal `(z, d)` is given; returns `(Σ g₀, Σ g₁)` of `g(i, out[i])` (the new values)
+/// summed block by block.
+fn pass(
+    out: &mut [f64],
+    z: Option<(&mut [f64], &[f64])>,
+    partials: &mut [[f64; 2]],
+    f: impl Fn(usize, f64) -> f64 + Sync,
+    g: impl Fn(usize, f64) -> [f64; 2] + Sync,
+) -> [f64; 2] {
+    let body = |blk: usize, chunk: &mut [f64], mut zd: Option<(&mut [f64], &[f64])>, acc: &mut [f64; 2]| {
+        let mut sum = [0.0; 2];
+        for (k, o) in chunk.iter_mut().enumerate() {
+            let i = blk * BLOCK + k;
+            *o = f(i, *o);
+            if let Some((zc, d)) = zd.as_mut() {
+                zc[k] = d[i] * *o;
+            }
+            let [a, b] = g(i, *o);
+            sum[0] += a;
+            sum[1] += b;
+        }
+        *acc = sum;
+    };
+    match z {
+        Some((z, d)) => out
+            .par_chunks_mut(BLOCK)
+            .zip(z.par_chunks_mut(BLOCK))
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(blk, ((chunk, zc), acc))| body(blk, chunk, Some((zc, d)), acc)),
+        None => out
+            .par_chunks_mut(BLOCK)
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(blk, (chunk, acc))| body(blk, chunk, None, acc)),
+    }
+    total(partials)
+}
+
+/// `out[i] = f(i, out[i])`, returning `(Σ g₀, Σ g₁)` of the new values (one pass).
+fn update(
+    out: &mut [f64],
+    partials: &mut [[f64; 2]],
+    f: impl Fn(usize, f64) -> f64 + Sync,
+    g: impl Fn(usize, f64) -> [f64; 2] + Sync,
+) -> [f64; 2] {
+    pass(out, None, partials, f, g)
+}
+
+/// [`update`], then `z = M⁻¹ out`: in the same pass when `m` is diagonal.
+fn update_preconditioned(
+    out: &mut [f64],
+    z: &mut [f64],
+    m: &impl Preconditioner,
+    partials: &mut [[f64; 2]],
+    f: impl Fn(usize, f64) -> f64 + Sync,
+    g: impl Fn(usize, f64) -> [f64; 2] + Sync,
+) -> [f64; 2] {
+    match m.diagonal() {
+        Some(d) => pass(out, Some((z, d)), partials, f, g),
+        None => {
+            let sums = pass(out, None, partials, f, g);
+            m.apply(out, z);
+            sums
+        }
+    }
+}
+
+/// `y[i] = h(i, (A x)_i)` block by block of rows, returning `(Σ g₀, Σ g₁)` of `g(i, y[i])`
+/// summed block by block (one pass).
+fn mul_reduce(
+    a: &PpeMatrix,
+    x: &[f64],
+    y: &mut [f64],
+    partials: &mut [[f64; 2]],
+    h: impl Fn(usize, f64) -> f64 + Sync,
+    g: impl Fn(usize, f64) -> [f64; 2] + Sync,
+) -> [f64; 2] {
+    pass(y, None, partials, |i, _| h(i, a.row_dot(i, x)), g)
 }
 
 /// A scalar that must be finite and non-zero for the recurrence to go on.
@@ -134,14 +208,12 @@ fn usable(value: f64, what: &'static str) -> Result<f64, KrylovError> {
     if value.is_finite() && value != 0.0 { Ok(value) } else { Err(KrylovError::Breakdown { what }) }
 }
 
-/// `‖b‖`, and `r = b − A x` with `‖r‖²` (`v` is scratch).
+/// `‖b‖`, and `r = b − A x` with `‖r‖²`.
 fn start(a: &PpeMatrix, b: &[f64], x: &[f64], ws: &mut Workspace) -> (f64, f64) {
     let n = b.len();
     ws.resize(n);
     let b_norm = reduce(n, &mut ws.partials, |i| [b[i] * b[i], 0.0])[0].sqrt();
-    a.mul(x, &mut ws.v);
-    let v = &ws.v;
-    let rr = update_reduce(&mut ws.r, &mut ws.partials, |i, _| b[i] - v[i], |_, r| [r * r, 0.0])[0];
+    let rr = mul_reduce(a, x, &mut ws.r, &mut ws.partials, |i, ax| b[i] - ax, |_, r| [r * r, 0.0])[0];
     (b_norm, rr)
 }
 
@@ -166,18 +238,46 @@ pub fn conjugate_gradient(
     p.copy_from_slice(z);
     let mut rz = reduce(n, partials, |i| [r[i] * z[i], 0.0])[0];
     for it in 1..=params.max_iterations {
-        a.mul(p, q);
-        let alpha = rz / usable(reduce(n, partials, |i| [p[i] * q[i], 0.0])[0], "pᵀAp")?;
-        update(x, |i, xi| xi + alpha * p[i]);
-        rr = update_reduce(r, partials, |i, ri| ri - alpha * q[i], |_, r| [r * r, 0.0])[0];
+        // q = A p with pᵀq.
+        let pq = mul_reduce(a, p, q, partials, |_, y| y, |i, qi| [p[i] * qi, 0.0])[0];
+        let alpha = rz / usable(pq, "pᵀAp")?;
+        // x += α p and r −= α q in one pass, with ‖r‖², z = M⁻¹ r and rᵀz.
+        let [r2, rz_new] = match m.diagonal() {
+            Some(d) => {
+                x.par_chunks_mut(BLOCK)
+                    .zip(r.par_chunks_mut(BLOCK))
+                    .zip(z.par_chunks_mut(BLOCK))
+                    .zip(partials.par_iter_mut())
+                    .enumerate()
+                    .for_each(|(blk, (((xc, rc), zc), acc))| {
+                        let mut sum = [0.0; 2];
+                        for k in 0..rc.len() {
+                            let i = blk * BLOCK + k;
+                            xc[k] += alpha * p[i];
+                            rc[k] -= alpha * q[i];
+                            zc[k] = d[i] * rc[k];
+                            sum[0] += rc[k] * rc[k];
+                            sum[1] += rc[k] * zc[k];
+                        }
+                        *acc = sum;
+                    });
+                total(partials)
+            }
+            None => {
+                update(x, partials, |i, xi| xi + alpha * p[i], |_, _| [0.0; 2]);
+                let r2 = update(r, partials, |i, ri| ri - alpha * q[i], |_, r| [r * r, 0.0])[0];
+                m.apply(r, z);
+                [r2, reduce(n, partials, |i| [r[i] * z[i], 0.0])[0]]
+            }
+        };
+        rr = r2;
         if rr.sqrt() <= stop {
             return Ok(it);
         }
-        m.apply(r, z);
-        let rz_new = reduce(n, partials, |i| [r[i] * z[i], 0.0])[0];
         let beta = rz_new / usable(rz, "rᵀz")?;
         rz = rz_new;
-        update(p, |i, pi| z[i] + beta * pi);
+        let z = &*z;
+        update(p, partials, |i, pi| z[i] + beta * pi, |_, _| [0.0; 2]);
     }
     Err(KrylovError::NoConvergence { residual: rr.sqrt() / b_norm })
 }
@@ -192,7 +292,6 @@ pub fn bicgstab(
     params: KrylovParams,
     ws: &mut Workspace,
 ) -> Result<usize, KrylovError> {
-    let n = b.len();
     let (b_norm, mut rr) = start(a, b, x, ws);
     let stop = params.tolerance * b_norm;
     if rr.sqrt() <= stop {
@@ -208,22 +307,51 @@ pub fn bicgstab(
     for it in 1..=params.max_iterations {
         usable(rho, "r̂ᵀr")?;
         let beta = (rho / rho_prev) * (alpha / omega);
-        update(p, |i, pi| r[i] + beta * (pi - omega * v[i]));
-        m.apply(p, p_hat);
-        a.mul(p_hat, v);
-        alpha = rho / usable(reduce(n, partials, |i| [r_hat[i] * v[i], 0.0])[0], "r̂ᵀv")?;
-        let ss = update_reduce(s, partials, |i, _| r[i] - alpha * v[i], |_, s| [s * s, 0.0])[0];
+        // p = r + β (p − ω v), p̂ = M⁻¹ p.
+        {
+            let (r, v) = (&*r, &*v);
+            update_preconditioned(
+                p,
+                p_hat,
+                m,
+                partials,
+                |i, pi| r[i] + beta * (pi - omega * v[i]),
+                |_, _| [0.0; 2],
+            );
+        }
+        // v = A p̂ with r̂ᵀv.
+        let rv = mul_reduce(a, p_hat, v, partials, |_, y| y, |i, vi| [r_hat[i] * vi, 0.0])[0];
+        alpha = rho / usable(rv, "r̂ᵀv")?;
+        // s = r − α v with ‖s‖², ŝ = M⁻¹ s.
+        let ss = {
+            let (r, v) = (&*r, &*v);
+            update_preconditioned(s, s_hat, m, partials, |i, _| r[i] - alpha * v[i], |_, s| [s * s, 0.0])[0]
+        };
         if ss.sqrt() <= stop {
-            update(x, |i, xi| xi + alpha * p_hat[i]);
+            let p_hat = &*p_hat;
+            update(x, partials, |i, xi| xi + alpha * p_hat[i], |_, _| [0.0; 2]);
             return Ok(it);
         }
-        m.apply(s, s_hat);
-        a.mul(s_hat, t);
-        let [ts, tt] = reduce(n, partials, |i| [t[i] * s[i], t[i] * t[i]]);
+        // t = A ŝ with tᵀs and tᵀt.
+        let [ts, tt] = mul_reduce(a, s_hat, t, partials, |_, y| y, |i, ti| [ti * s[i], ti * ti]);
         omega = usable(ts / usable(tt, "tᵀt")?, "ω")?;
-        update(x, |i, xi| xi + alpha * p_hat[i] + omega * s_hat[i]);
-        let [r2, rho_next] =
-            update_reduce(r, partials, |i, _| s[i] - omega * t[i], |i, ri| [ri * ri, r_hat[i] * ri]);
+        // x += α p̂ + ω ŝ and r = s − ω t in one pass, with ‖r‖² and r̂ᵀr.
+        x.par_chunks_mut(BLOCK)
+            .zip(r.par_chunks_mut(BLOCK))
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(blk, ((xc, rc), acc))| {
+                let mut sum = [0.0; 2];
+                for k in 0..rc.len() {
+                    let i = blk * BLOCK + k;
+                    xc[k] = xc[k] + alpha * p_hat[i] + omega * s_hat[i];
+                    rc[k] = s[i] - omega * t[i];
+                    sum[0] += rc[k] * rc[k];
+                    sum[1] += r_hat[i] * rc[k];
+                }
+                *acc = sum;
+            });
+        let [r2, rho_next] = total(partials);
         rr = r2;
         if rr.sqrt() <= stop {
             return Ok(it);

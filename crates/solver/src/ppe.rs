@@ -47,14 +47,18 @@ impl PpeMatrix {
 
     /// y = A x (row-parallel, deterministic).
     pub fn mul(&self, x: &[f64], y: &mut [f64]) {
-        y.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, yi)| {
-            let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
-            let mut acc = 0.0;
-            for (&c, &v) in self.cols[s..e].iter().zip(&self.vals[s..e]) {
-                acc += v * x[c as usize];
-            }
-            *yi = acc;
-        });
+        y.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, yi)| *yi = self.row_dot(i, x));
+    }
+
+    /// (A x)_i, summed over the row's entries in their stored order.
+    #[inline]
+    pub fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
+        let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
+        let mut acc = 0.0;
+        for (&c, &v) in self.cols[s..e].iter().zip(&self.vals[s..e]) {
+            acc += v * x[c as usize];
+        }
+        acc
     }
 
     /// Sizes the entry arrays for the row offsets already in `row_ptr`.
@@ -109,6 +113,10 @@ impl Preconditioner for Jacobi<'_> {
         z.par_iter_mut().zip(r).zip(self.0).with_min_len(krylov::BLOCK).for_each(|((zi, ri), di)| {
             *zi = di * ri;
         });
+    }
+
+    fn diagonal(&self) -> Option<&[f64]> {
+        Some(self.0)
     }
 }
 
