@@ -248,43 +248,65 @@ impl<const D: usize> CellSearch<D> {
         let r2 = self.radius * self.radius;
         let mut chunk_rows = std::mem::take(&mut self.chunk_rows);
         let this = &*self;
+        let fill = |c: usize, rows: &mut Vec<u32>, counts: &mut [usize]| {
+            if this.domain.is_periodic() {
+                this.fill_chunk(x, c * CHUNK, r2, rows, counts, |a, b| this.domain.displacement(a, b));
+            } else {
+                this.fill_chunk(x, c * CHUNK, r2, rows, counts, |a, b| a - b);
+            }
+        };
         chunk_rows[..nchunks]
             .par_iter_mut()
             .zip(list.offsets[1..].par_chunks_mut(CHUNK))
             .enumerate()
-            .for_each(|(c, (rows, counts))| {
-                rows.clear();
-                for (k, count) in counts.iter_mut().enumerate() {
-                    let a = c * CHUNK + k;
-                    let before = rows.len();
-                    // Copy each run of candidates, then keep the neighbours by a
-                    // branch-free compaction in place: whether a candidate is within the
-                    // radius is random from one to the next (about a third are), and a
-                    // mispredicted branch per candidate cost more than the copy.
-                    this.visit_candidates(&x[a], |run| {
-                        let start = rows.len();
-                        rows.extend_from_slice(run);
-                        let mut kept = start;
-                        for i in start..rows.len() {
-                            let b = rows[i];
-                            let d2 = this.domain.displacement(&x[a], &x[b as usize]).norm_squared();
-                            rows[kept] = b;
-                            kept += usize::from((d2 < r2) & (b as usize != a));
-                        }
-                        rows.truncate(kept);
-                    });
-                    *count = rows.len() - before;
-                }
-            });
+            .for_each(|(c, (rows, counts))| fill(c, rows, counts));
         list.offsets[0] = 0;
         for a in 0..n {
             list.offsets[a + 1] += list.offsets[a];
         }
-        list.indices.clear();
-        for rows in &chunk_rows[..nchunks] {
-            list.indices.extend_from_slice(rows);
-        }
+        list.indices.resize(list.offsets[n], 0);
+        copy_chunks(&chunk_rows[..nchunks], &mut list.indices);
         self.chunk_rows = chunk_rows;
+    }
+
+    /// The neighbour rows of particles `first..first + counts.len()` appended to `rows`,
+    /// with each row's length in `counts`; `disp` is the displacement of the domain (the
+    /// plain difference when nothing is periodic, so the hot loop has no per-axis test).
+    ///
+    /// Whether a candidate is within the radius is random from one to the next (about a
+    /// third are), so a branch per candidate mispredicts often: the candidates of a run are
+    /// tested in groups of 64 into a bit mask without branches, and the set bits are then
+    /// read off in order (the same neighbours in the same order as a plain filter).
+    #[inline(always)]
+    fn fill_chunk(
+        &self,
+        x: &[SVector<f64, D>],
+        first: usize,
+        r2: f64,
+        rows: &mut Vec<u32>,
+        counts: &mut [usize],
+        disp: impl Fn(&SVector<f64, D>, &SVector<f64, D>) -> SVector<f64, D>,
+    ) {
+        rows.clear();
+        for (k, count) in counts.iter_mut().enumerate() {
+            let a = first + k;
+            let xa = x[a];
+            let before = rows.len();
+            self.visit_candidates(&xa, |run| {
+                for group in run.chunks(64) {
+                    let mut mask = 0u64;
+                    for (i, &b) in group.iter().enumerate() {
+                        let d2 = disp(&xa, &x[b as usize]).norm_squared();
+                        mask |= u64::from((d2 < r2) & (b as usize != a)) << i;
+                    }
+                    while mask != 0 {
+                        rows.push(group[mask.trailing_zeros() as usize]);
+                        mask &= mask - 1;
+                    }
+                }
+            });
+            *count = rows.len() - before;
+        }
     }
 
     /// Calls `f` with runs of `sorted` that together hold every particle in the 3^D cells
@@ -371,6 +393,18 @@ impl<const D: usize> CellSearch<D> {
         } else {
             None
         }
+    }
+}
+
+/// Copies the concatenation of `chunks` into `dst` (of their total length), the chunks in
+/// parallel.
+fn copy_chunks(chunks: &[Vec<u32>], dst: &mut [u32]) {
+    if let [chunk] = chunks {
+        dst.copy_from_slice(chunk);
+    } else if chunks.len() > 1 {
+        let mid = chunks.len() / 2;
+        let (l, r) = dst.split_at_mut(chunks[..mid].iter().map(Vec::len).sum());
+        rayon::join(|| copy_chunks(&chunks[..mid], l), || copy_chunks(&chunks[mid..], r));
     }
 }
 
