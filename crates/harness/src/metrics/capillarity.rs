@@ -10,7 +10,10 @@
 //!   `max_speed` probe), `u_spurious_rms_late`.
 //! - oscillating drop (`R`, `σ`, `ρ`; ν from the scene): the deformation
 //!   `d(t) = a_moment − b_moment` (`ellipse_axes`); its period `period` from the mean
-//!   spacing of its zero crossings (linear interpolation; at least two crossings) and
+//!   spacing of its zero crossings (linear interpolation; at least two crossings; a
+//!   crossing counts only after an excursion beyond ±[`HYSTERESIS`] × max |d| (over the
+//!   first reference period) on the other side, so a deformation that touches zero and
+//!   bounces back adds none) and
 //!   `period_rel_err` against mode 2, `2π √(ρR³/(6σ))`; the amplitude decay rate
 //!   `damping_rate` (least-squares fit of `ln |d|` at the extremum of every half cycle)
 //!   and `damping_rel_err` against `4ν/R²`.
@@ -70,10 +73,49 @@ pub fn crossings(t: &[f64], v: &[f64], level: f64) -> Vec<f64> {
     out
 }
 
+/// Times at which `v − level` changes side between two excursions beyond `±band`: a
+/// crossing is counted only once the signal has gone further than `band` on the other side
+/// (hysteresis), so that noise which touches `level` and bounces back, or dithers about it,
+/// adds no crossing. Each time is the last sign change (linear interpolation) before the
+/// excursion; with `band = 0` this is [`crossings`].
+pub fn crossings_with_hysteresis(t: &[f64], v: &[f64], level: f64, band: f64) -> Vec<f64> {
+    let mut out = Vec::new();
+    let (mut side, mut last_change) = (0_i8, None);
+    for i in 0..t.len().min(v.len()) {
+        let b = v[i] - level;
+        if i > 0 {
+            let a = v[i - 1] - level;
+            if a != 0.0 && a.signum() != b.signum() && b != 0.0 || (b == 0.0 && a != 0.0) {
+                last_change = Some(t[i - 1] + (t[i] - t[i - 1]) * a / (a - b));
+            }
+        }
+        let here: i8 = if b > band {
+            1
+        } else if b < -band {
+            -1
+        } else {
+            0
+        };
+        if here != 0 && here != side {
+            if side != 0
+                && let Some(c) = last_change
+            {
+                out.push(c);
+            }
+            side = here;
+        }
+    }
+    out
+}
+
 /// Period `2 × mean spacing` of successive crossings (NaN with fewer than two).
 pub fn period_from_crossings(c: &[f64]) -> f64 {
     if c.len() < 2 { f64::NAN } else { 2.0 * (c[c.len() - 1] - c[0]) / (c.len() - 1) as f64 }
 }
+
+/// The hysteresis band of the deformation's zero crossings as a fraction of its largest
+/// magnitude over the first reference period.
+pub const HYSTERESIS: f64 = 0.2;
 
 /// Mean of the samples with `t ≥ from`.
 fn mean_after(t: &[f64], v: &[f64], from: f64) -> f64 {
@@ -134,8 +176,19 @@ pub fn compute(case: &Capillary, probes: &ProbeRecord) -> Result<Measured, Refer
                 (probes.get("ellipse_axes", "a_moment"), probes.get("ellipse_axes", "b_moment"))
             {
                 let d: Vec<f64> = a.iter().zip(b).map(|(a, b)| a - b).collect();
-                let c = crossings(t, &d, 0.0);
+                // Crossings of zero between excursions beyond a fifth of the deformation's
+                // scale: its largest |d| over the first reference period (the imposed
+                // deformation, before surface particles that may leave later bias the
+                // moments).
+                let scale = t
+                    .iter()
+                    .zip(&d)
+                    .filter(|(x, _)| **x <= t[0] + period_ref)
+                    .fold(0.0_f64, |m, (_, y)| m.max(y.abs()));
+                let band = HYSTERESIS * scale;
+                let c = crossings_with_hysteresis(t, &d, 0.0, band);
                 let period = period_from_crossings(&c);
+                m.insert("period_crossings".into(), c.len() as f64);
                 m.insert("period".into(), period);
                 m.insert("period_rel_err".into(), ((period - period_ref) / period_ref).abs());
                 // Extremum of |d| in every complete half cycle.
@@ -223,6 +276,31 @@ mod tests {
         );
         let m2 = compute(&Capillary::Oscillating { radius, sigma, density, nu }, &r2).unwrap().metrics;
         assert!((m2["period_rel_err"] - 0.1).abs() < 2e-3, "{m2:?}");
+    }
+
+    #[test]
+    fn hysteresis_ignores_bounces_and_dither_at_zero() {
+        let t: Vec<f64> = (0..2000).map(|i| i as f64 * 5e-4).collect();
+        // A deformation that comes down to zero, dips to −1 % of its amplitude and goes back
+        // (a bounce, not a half cycle), twice over the second: four plain crossings, none
+        // with hysteresis.
+        let bounce: Vec<f64> = t.iter().map(|x| 0.0101 * (1.0 + (10.0 * x).cos()) / 2.0 - 1e-4).collect();
+        assert_eq!(crossings(&t, &bounce, 0.0).len(), 4);
+        assert!(crossings_with_hysteresis(&t, &bounce, 0.0, 0.2 * 0.01).is_empty());
+        // A 0.25 s oscillation with particle-scale dither of 5 % of its amplitude at a
+        // frequency 37 times higher: the dither crosses zero several times at every node.
+        let w = 2.0 * std::f64::consts::PI / 0.25;
+        let d: Vec<f64> =
+            t.iter().map(|x| 0.01 * (w * x).sin() + 5e-4 * (37.0 * w * x + 1.0).sin()).collect();
+        let plain = crossings(&t, &d, 0.0);
+        let c = crossings_with_hysteresis(&t, &d, 0.0, 0.2 * 0.01);
+        assert_eq!(c.len(), 7, "{c:?}");
+        assert!(plain.len() > c.len(), "{plain:?}");
+        let p = period_from_crossings(&c);
+        assert!((p / 0.25 - 1.0).abs() < 0.01, "{p}");
+        // Without noise, hysteresis and plain crossings agree.
+        let clean: Vec<f64> = t.iter().map(|x| (w * x + 0.3).sin()).collect();
+        assert_eq!(crossings(&t, &clean, 0.0), crossings_with_hysteresis(&t, &clean, 0.0, 0.2));
     }
 
     #[test]
