@@ -190,8 +190,11 @@ fn update_preconditioned(
     }
 }
 
-/// `y[i] = h(i, (A x)_i)` block by block of rows, returning `(Σ g₀, Σ g₁)` of `g(i, y[i])`
-/// summed block by block (one pass).
+/// `y[i] = h(i, (A x)_i)`, returning `(Σ g₀, Σ g₁)` of `g(i, y[i])` summed block by block
+/// (one pass). The product is split finer than a block (rows of very different cost, and
+/// a block is a quarter of the drop's system at Δx = 0.02: with two threads, fixed blocks
+/// left one thread doing three of the four, measured 1.5 times slower than row-parallel);
+/// each block then sums its rows in order, so the sums are still the same bits.
 fn mul_reduce(
     a: &PpeMatrix,
     x: &[f64],
@@ -200,7 +203,20 @@ fn mul_reduce(
     h: impl Fn(usize, f64) -> f64 + Sync,
     g: impl Fn(usize, f64) -> [f64; 2] + Sync,
 ) -> [f64; 2] {
-    pass(y, None, partials, |i, _| h(i, a.row_dot(i, x)), g)
+    y.par_chunks_mut(BLOCK).zip(partials.par_iter_mut()).enumerate().for_each(|(blk, (chunk, acc))| {
+        let base = blk * BLOCK;
+        chunk.par_iter_mut().enumerate().with_min_len(256).for_each(|(k, yi)| {
+            *yi = h(base + k, a.row_dot(base + k, x));
+        });
+        let mut sum = [0.0; 2];
+        for (k, &yi) in chunk.iter().enumerate() {
+            let [p, q] = g(base + k, yi);
+            sum[0] += p;
+            sum[1] += q;
+        }
+        *acc = sum;
+    });
+    total(partials)
 }
 
 /// A scalar that must be finite and non-zero for the recurrence to go on.
