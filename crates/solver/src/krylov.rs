@@ -11,7 +11,8 @@
 //! fixed blocks of [`BLOCK`] entries in parallel and adds the block sums serially in block
 //! order, so the result is the same for every thread count.
 //!
-//! Every pass over the vectors is one parallel loop over those blocks, and the work of an
+//! Every pass over the vectors is one parallel loop over those blocks (the matrix product
+//! also splits each block's rows among the threads), and the work of an
 //! iteration is fused into as few passes as the recurrence allows: a matrix product with
 //! the dot product that follows it, a vector update with its norm, and with a diagonal
 //! (Jacobi) preconditioner also with the preconditioner's application. On the 7860-row
@@ -191,10 +192,10 @@ fn update_preconditioned(
 }
 
 /// `y[i] = h(i, (A x)_i)`, returning `(Σ g₀, Σ g₁)` of `g(i, y[i])` summed block by block
-/// (one pass). The product is split finer than a block (rows of very different cost, and
-/// a block is a quarter of the drop's system at Δx = 0.02: with two threads, fixed blocks
-/// left one thread doing three of the four, measured 1.5 times slower than row-parallel);
-/// each block then sums its rows in order, so the sums are still the same bits.
+/// (one pass). The product is split finer than a block: a block is a quarter of the
+/// drop's system at Δx = 0.02, and with two threads whole blocks as tasks often left one
+/// thread three of the four (the solve measured 1.5 times slower than row-parallel); each
+/// block then sums its rows in order, so the sums are still the same bits.
 fn mul_reduce(
     a: &PpeMatrix,
     x: &[f64],
