@@ -328,6 +328,11 @@ fn malformed_scene_table() {
         ("bodies[0].jitter.amplitude", "unknown field", |v| {
             v["bodies"][0]["jitter"] = json!({"fraction": 0.1, "seed": 1, "amplitude": 2})
         }),
+        ("bodies[0].packing", "needs a circle", |v| {
+            v["bodies"][0]["shape"] = json!({"rectangle": {"min": [-0.5, -0.5], "max": [0.5, 0.5]}});
+            v["bodies"][0]["packing"] = json!("rings");
+        }),
+        ("bodies[0].packing", "", |v| v["bodies"][0]["packing"] = json!("hexagonal")),
         ("name", "empty", |v| v["name"] = json!("  ")),
         ("name", "", |v| v["name"] = json!(42)),
         ("probes[0]", "", |v| v["probes"] = json!([{"vorticity": {}}])),

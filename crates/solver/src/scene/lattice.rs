@@ -4,7 +4,7 @@
 //! is symmetric about the centre; a disc keeps the points with `|x − c| ≤ R`
 //! (R = 1, Δx = 0.04 gives the 1976 particles of Qiu 2013 §3.1).
 
-use super::schema::{Body, InitialPressure, InitialVelocity, Jitter, Shape};
+use super::schema::{Body, InitialPressure, InitialVelocity, Jitter, Packing, Shape};
 use nalgebra::{SMatrix, SVector};
 use rand::{Rng, SeedableRng};
 
@@ -56,6 +56,29 @@ pub fn lattice_points<const D: usize>(shape: &Shape, dx: f64) -> Vec<SVector<f64
     }
 }
 
+/// Concentric rings filling the disc of `radius` about `center` (`Packing::Rings`): ring
+/// `k = 1..n`, `n = max(1, round(R/Δx))`, at `r_k = (k − ½) R/n` holds
+/// `m_k = round(2π (k − ½))` particles at the angles `2π (j + ½)/m_k`. The annulus of ring
+/// `k` has the area `2π r_k R/n`, so every particle stands for `(R/n)² (2π(k − ½)/m_k)`,
+/// within 5 % of `(R/n)²` for `k ≥ 2` (the inner ring's 3 particles cover `π (R/n)²`).
+fn ring_points<const D: usize>(center: &[f64], radius: f64, dx: f64) -> Vec<SVector<f64, D>> {
+    let n = ((radius / dx).round() as usize).max(1);
+    let spacing = radius / n as f64;
+    let mut out = Vec::new();
+    for k in 1..=n {
+        let ring = k as f64 - 0.5;
+        let m = (2.0 * std::f64::consts::PI * ring).round() as usize;
+        for j in 0..m {
+            let theta = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / m as f64;
+            let (s, c) = theta.sin_cos();
+            out.push(SVector::<f64, D>::from_fn(|i, _| {
+                center[i] + ring * spacing * if i == 0 { c } else { s }
+            }));
+        }
+    }
+    out
+}
+
 /// Seeds (position, velocity, pressure) of one body; `g` is the body force for hydrostatic
 /// pressure, `density` the fluid density \[kg/m³\].
 pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector<f64, D>) -> Vec<Seed<D>> {
@@ -79,10 +102,11 @@ pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector
             density * g.dot(&(x - s))
         }
     };
-    lattice_points::<D>(&body.shape, dx)
-        .into_iter()
-        .map(|x| Seed { x, u: velocity(&x), p: pressure(&x) })
-        .collect()
+    let points = match (body.packing, &body.shape) {
+        (Packing::Rings, Shape::Circle { center, radius }) => ring_points::<D>(center, *radius, dx),
+        _ => lattice_points::<D>(&body.shape, dx),
+    };
+    points.into_iter().map(|x| Seed { x, u: velocity(&x), p: pressure(&x) }).collect()
 }
 
 /// Displaces every point by a vector uniform in the ball of radius `jitter.fraction · dx`
@@ -138,6 +162,26 @@ mod tests {
         // CASES.md: 1976, 7860, 31428, 125676 particles.
         for (dx, n) in [(0.04, 1976), (0.02, 7860), (0.01, 31428), (0.005, 125676)] {
             assert_eq!(lattice_points::<2>(&disc(1.0), dx).len(), n, "dx = {dx}");
+        }
+    }
+
+    #[test]
+    fn rings_fill_the_disc_with_one_spacing_per_particle() {
+        let (r, dx) = (0.2, 0.01);
+        let pts = ring_points::<2>(&[0.1, -0.3], r, dx);
+        // Σ_k round(2π (k − ½)) for k = 1..20, against π R²/Δx² = 1256.6.
+        assert_eq!(pts.len(), 1257);
+        let c = SVector::<f64, 2>::new(0.1, -0.3);
+        let radii: Vec<f64> = pts.iter().map(|x| (x - c).norm()).collect();
+        let outer = radii.iter().cloned().fold(0.0, f64::max);
+        assert!((outer - (r - 0.5 * dx)).abs() < 1e-12, "outer ring half a spacing inside R");
+        let centroid: SVector<f64, 2> = pts.iter().sum::<SVector<f64, 2>>() / pts.len() as f64;
+        assert!((centroid - c).norm() < 1e-12);
+        // No two particles closer than 0.8 Δx (the ring spacing is Δx along and across).
+        for (i, a) in pts.iter().enumerate() {
+            for b in &pts[i + 1..] {
+                assert!((a - b).norm() > 0.8 * dx, "{a} and {b}");
+            }
         }
     }
 

@@ -6,7 +6,7 @@ use super::schema::*;
 use crate::error::SceneError;
 
 /// Checks `boundaries.walls`, `boundaries.inflow`/`outflow`, the `velocity_profile`
-/// probes, `output.probe_times`, `output.snapshot_times` and the bodies' `jitter`.
+/// probes, `output.probe_times`, `output.snapshot_times` and the bodies' `jitter` and `packing`.
 pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
     let d = scene.dimension;
     open_boundaries(scene)?;
@@ -76,6 +76,13 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
         }
     }
     for (i, body) in scene.bodies.iter().enumerate() {
+        if body.packing == Packing::Rings && !(d == 2 && matches!(body.shape, Shape::Circle { .. })) {
+            return Err(SceneError::new(
+                format!("bodies[{i}].packing"),
+                "rings",
+                "needs a circle in a 2D scene (concentric rings fill a disc)",
+            ));
+        }
         if let Some(j) = &body.jitter {
             let f = format!("bodies[{i}].jitter.fraction");
             finite(&f, j.fraction)?;
