@@ -219,8 +219,9 @@ impl<const D: usize> Stage<D> for PpeSolveStage {
 }
 
 /// Velocity correction (Qiu eq. 6): `u^{n+1} = u* − Δt (∇p/ρ)` with the symmetric gradient
-/// of Qiu eq. 15, `Σ_b V_b (p_a + p_b) ∇_aW_ab / ρ`, or the difference form
-/// `Σ_b V_b (p_b − p_a) ∇_aW_ab / ρ`.
+/// of Qiu eq. 15, `Σ_b V_b (p_a + p_b) ∇_aW_ab / ρ`, the difference form
+/// `Σ_b V_b (p_b − p_a) ∇_aW_ab / ρ`, or the difference form with the kernel-gradient
+/// correction `L_a = (Σ_b V_b (r_b − r_a) ⊗ ∇_aW_ab)⁻¹` (Bonet & Lok 1999, eq. 43).
 #[derive(Debug)]
 pub struct Correction {
     /// Gradient form.
@@ -237,13 +238,26 @@ impl<const D: usize> Stage<D> for Correction {
         let c = ctx.dt * s.volume / s.density;
         let sign = match self.form {
             PressureGradient::Symmetric => 1.0,
-            PressureGradient::Difference => -1.0,
+            PressureGradient::Difference | PressureGradient::Corrected => -1.0,
         };
+        let corrected = self.form == PressureGradient::Corrected;
+        let dt_rho = ctx.dt / s.density;
         s.particles.u[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let mut g = Vector::<D>::zeros();
             for (pr, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                 g += pr.r_ab * (pr.f * (p[b as usize] + sign * p[a]));
+            }
+            if corrected {
+                // m = Σ_b (r_b − r_a) ⊗ ∇_aW_ab (symmetric), so ∇p_a = (V m)⁻¹ (V g).
+                let mut m = SMatrix::<f64, D, D>::zeros();
+                for pr in &pairs[lo..hi] {
+                    m -= pr.r_ab * pr.r_ab.transpose() * pr.f;
+                }
+                if let Some(mi) = m.try_inverse() {
+                    *u -= mi * g * dt_rho;
+                    return;
+                }
             }
             *u -= g * c;
         });

@@ -564,6 +564,12 @@ pub enum PressureGradient {
     Symmetric,
     /// `Σ V_b (p_b − p_a) ∇W / ρ` (zero-order consistent).
     Difference,
+    /// The difference form with the kernel-gradient correction (Bonet & Lok 1999, eq. 43;
+    /// Randles & Libersky 1996): `L_a Σ V_b (p_b − p_a) ∇W / ρ`,
+    /// `L_a = (Σ V_b (r_b − r_a) ⊗ ∇_aW_ab)⁻¹`, first-order consistent also where a free
+    /// surface truncates the kernel support (the plain form gives about half the gradient
+    /// on the surface row); the plain form where the matrix is singular.
+    Corrected,
 }
 
 /// End time and time-step rule.

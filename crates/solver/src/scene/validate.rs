@@ -430,7 +430,7 @@ fn matrix(field: &str, m: &[Vec<f64>], d: usize) -> Result<(), SceneError> {
 }
 
 /// `fluid.surface_tension_model: young_laplace` sets the free-surface pressure of the
-/// projection, so it needs the ISPH scheme and the difference pressure gradient (the
+/// projection, so it needs the ISPH scheme and the difference (or corrected) pressure gradient (the
 /// symmetric form adds `2 p_a Σ V ∇W`, an outward push on surface particles whose pressure
 /// is not zero).
 fn validate_young_laplace(scene: &Scene) -> Result<(), SceneError> {
@@ -440,11 +440,11 @@ fn validate_young_laplace(scene: &Scene) -> Result<(), SceneError> {
         return Ok(());
     }
     match &scene.scheme {
-        Scheme::Isph(o) if o.pressure_gradient == PressureGradient::Difference => Ok(()),
+        Scheme::Isph(o) if o.pressure_gradient != PressureGradient::Symmetric => Ok(()),
         Scheme::Isph(_) => Err(SceneError::new(
             "fluid.surface_tension_model",
             "young_laplace",
-            "needs scheme.isph.pressure_gradient = \"difference\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)",
+            "needs scheme.isph.pressure_gradient = \"difference\" or \"corrected\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)",
         )),
         Scheme::Wcsph(_) => Err(SceneError::new(
             "fluid.surface_tension_model",
