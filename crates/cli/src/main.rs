@@ -51,8 +51,8 @@ enum Command {
         /// Output directory.
         #[arg(long, default_value = "out")]
         out: PathBuf,
-        /// Write a VTK frame (frames/*.vtu) every N steps (overrides output.vtk_every); a run
-        /// that diverges also writes the particles before the failing step to
+        /// Write a VTK frame (frames/*.vtu) every N steps (overrides output.vtk_every). A run
+        /// that diverges always writes the particles before the failing step to
         /// frames/last_good.vtu.
         #[arg(long)]
         vtk_every: Option<usize>,

@@ -102,14 +102,16 @@ pub fn run(
         out.display()
     );
     let Some(e) = &report.error else { return Ok(()) };
-    let last_good = match (&obs.frames, &report.last_good) {
-        (Some(dir), Some(frame)) => {
-            let path = vtk::write_frame_as(dir, "last_good", frame)?;
+    // The last good state is written whether or not frames were requested: it is what a
+    // user opens first to see what went wrong.
+    let last_good = match &report.last_good {
+        Some(frame) => {
+            let dir = obs.frames.clone().unwrap_or_else(|| out.join("frames"));
+            writable_dir(&dir)?;
+            let path = vtk::write_frame_as(&dir, "last_good", frame)?;
             format!("the particles at the start of step {} are in {}", frame.step + 1, path.display())
         }
-        _ => "rerun with --vtk-every N to get the particles before the failing step in \
-              frames/last_good.vtu"
-            .to_string(),
+        None => "no step had passed the guards, so there is no last good state to write".to_string(),
     };
     Err(Diverged(format!(
         "{e}\n  {last_good}\n  probes and summary up to the divergence are in {}",
