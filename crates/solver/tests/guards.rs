@@ -115,3 +115,24 @@ fn an_overstep_next_to_mirror_walls_is_a_typed_error() {
     let err = report.error.as_ref().expect("the run must diverge");
     assert!(matches!(err.cause, Cause::Overstep { .. }), "{err}");
 }
+
+#[test]
+fn an_adaptive_step_below_its_floor_is_a_typed_error_at_the_first_step() {
+    // A strain of 1e10 1/s on a 1 m drop: the CFL step 0.2 h/u_max ≈ 6e-13 s is below the
+    // floor 1e-9 × t_end = 1e-9 s.
+    let scene = common::drop_scene(|v| {
+        v["dx"] = json!(0.1);
+        v["bodies"][0]["velocity"]["affine"]["gradient"] = json!([[-1e10, 0.0], [0.0, 1e10]]);
+        v["time"] = json!({"end": 1.0, "step": {"adaptive": {"max": 1e-4}}});
+    });
+    let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
+    let err = report.error.as_ref().expect("the step is below its floor");
+    assert_eq!((err.stage, err.step, err.time), ("time_step", 1, 0.0));
+    let Cause::DtFloor { dt, floor } = err.cause else { panic!("{err}") };
+    assert!(dt < floor && (floor - 1e-9).abs() < 1e-24, "{err}");
+    assert_eq!(report.summary.status, "diverged");
+    assert_eq!(report.summary.steps, 0);
+    let msg = err.to_string();
+    assert!(msg.contains("time_step") && msg.contains("floor"), "{msg}");
+    assert!(report.last_good.is_some(), "the initial state is the last good state");
+}
