@@ -136,3 +136,21 @@ fn an_adaptive_step_below_its_floor_is_a_typed_error_at_the_first_step() {
     assert!(msg.contains("time_step") && msg.contains("floor"), "{msg}");
     assert!(report.last_good.is_some(), "the initial state is the last good state");
 }
+
+#[test]
+fn a_ppe_that_does_not_converge_is_a_typed_error_naming_the_solver_and_residual() {
+    // One BiCGSTAB iteration cannot reach a relative residual of 1e-12.
+    let scene = common::drop_scene(|v| {
+        v["dx"] = json!(0.1);
+        v["scheme"]["isph"]["ppe"] = json!({"solver": "bicgstab", "tolerance": 1e-12, "max_iterations": 1});
+    });
+    let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
+    let err = report.error.as_ref().expect("the PPE cannot converge");
+    assert_eq!(err.step, 1, "{err}");
+    let Cause::PpeNoConvergence { solver, residual, iterations } = &err.cause else { panic!("{err}") };
+    assert_eq!((*solver, *iterations), ("bicgstab", 1), "{err}");
+    assert!(residual.is_finite() && *residual > 1e-12, "{err}");
+    let msg = err.to_string();
+    assert!(msg.contains(err.stage) && msg.contains("max_iterations"), "{msg}");
+    assert!(report.last_good.is_some());
+}
