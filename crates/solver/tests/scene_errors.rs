@@ -155,6 +155,13 @@ fn malformed_scene_table() {
         ("scheme", "", |v| v["scheme"] = json!({"mps": {}})),
         ("scheme.wcsph.sound_speed", "positive", |v| v["scheme"] = json!({"wcsph": {"sound_speed": -10.0}})),
         ("scheme.wcsph.sound_speed", "positive", |v| v["scheme"] = json!({"wcsph": {"sound_speed": 0.0}})),
+        ("scheme.wcsph.shifting.xu.coefficient", "at most 1", |v| {
+            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "shifting": {"xu": {"coefficient": 2.0}}}})
+        }),
+        ("scheme.wcsph.shifting.fickian.coefficient", "positive", |v| {
+            v["scheme"] =
+                json!({"wcsph": {"sound_speed": 10.0, "shifting": {"fickian": {"coefficient": 0.0}}}})
+        }),
         ("scheme.wcsph.gamma", "1..=10", |v| {
             v["scheme"] = json!({"wcsph": {"sound_speed": 10.0, "gamma": 0.5}})
         }),

@@ -387,6 +387,11 @@ pub struct WcsphOptions {
     /// Velocity divergence of the continuity equation.
     #[serde(default)]
     pub continuity: ContinuityForm,
+    /// Particle shifting after the second half kick (none if absent): the ISPH stage
+    /// ([`crate::isph::shifting`]), with its free-surface scaling on `div r` against the
+    /// threshold `D − ½` (1.5 in 2D, Qiu eq. 16 as corrected).
+    #[serde(default)]
+    pub shifting: Shifting,
 }
 
 /// Velocity divergence of the weakly compressible continuity equation.

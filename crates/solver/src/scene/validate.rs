@@ -247,26 +247,27 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
             "is explicit only: the implicit viscous solve uses the shao_lo operator",
         ));
     }
-    match o.shifting {
+    validate_shifting("scheme.isph.shifting", o.shifting)?;
+    Ok(())
+}
+
+/// The coefficient rules of a shifting law at `field` (`scheme.isph.shifting` or
+/// `scheme.wcsph.shifting`).
+fn validate_shifting(field: &str, shifting: Shifting) -> Result<(), SceneError> {
+    match shifting {
         Shifting::None => {}
         Shifting::Xu { coefficient } => {
-            positive("scheme.isph.shifting.xu.coefficient", coefficient)?;
+            let f = format!("{field}.xu.coefficient");
+            positive(&f, coefficient)?;
             if coefficient > 1.0 {
-                return Err(SceneError::new(
-                    "scheme.isph.shifting.xu.coefficient",
-                    coefficient,
-                    "must be at most 1 (Xu 2009 uses 0.01–0.1)",
-                ));
+                return Err(SceneError::new(f, coefficient, "must be at most 1 (Xu 2009 uses 0.01–0.1)"));
             }
         }
         Shifting::Fickian { coefficient } => {
-            positive("scheme.isph.shifting.fickian.coefficient", coefficient)?;
+            let f = format!("{field}.fickian.coefficient");
+            positive(&f, coefficient)?;
             if coefficient > 10.0 {
-                return Err(SceneError::new(
-                    "scheme.isph.shifting.fickian.coefficient",
-                    coefficient,
-                    "must be at most 10 (Lind 2012 uses 1–6)",
-                ));
+                return Err(SceneError::new(f, coefficient, "must be at most 10 (Lind 2012 uses 1–6)"));
             }
         }
     }
@@ -275,6 +276,7 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
 
 fn validate_wcsph(o: &WcsphOptions) -> Result<(), SceneError> {
     positive("scheme.wcsph.sound_speed", o.sound_speed)?;
+    validate_shifting("scheme.wcsph.shifting", o.shifting)?;
     finite("scheme.wcsph.gamma", o.gamma)?;
     if !(1.0..=10.0).contains(&o.gamma) {
         return Err(SceneError::new(

@@ -7,7 +7,8 @@
 //! → `continuity` (ρ and the Tait pressure; density diffusion; [`forces`]) →
 //! `dummy_pressure` (dummy walls only) → `momentum` (Tait pressure gradient, Shao–Lo
 //! viscosity, Monaghan artificial viscosity, body force; [`forces`]) → `kick` (second half
-//! kick of u).
+//! kick of u) → `free_surface` and `shifting` (only with `scheme.wcsph.shifting`: the ISPH
+//! shifting stage with its Taylor correction of u).
 //!
 //! The time step ([`crate::run`]) is fixed or adaptive: `Δt = min(α_c h/(c₀ + |u|_max),
 //! α_d ρ h²/μ, 0.25 √(h/|a|_max), max)` (Monaghan 1992 §10; Morris 1997 eq. 23).
@@ -16,10 +17,12 @@ pub mod eos;
 pub mod forces;
 pub mod integrator;
 
+use crate::isph::shifting::Law;
 use crate::kernel::{Kernel, Scaled};
-use crate::scene::{Scene, WallModel, WcsphOptions};
+use crate::scene::{Scene, Shifting, WallModel, WcsphOptions};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
+use crate::stages::free_surface::FreeSurface;
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::surface_tension::{Apply, Force, SurfaceTension};
 use crate::stages::{reorder::Reorder, walls};
@@ -103,5 +106,16 @@ pub fn build_stages<K: Kernel, const D: usize>(
     stages.push(forces::momentum(params));
     stages.extend(tension());
     stages.push(Box::new(integrator::Kick));
+    let law = match opts.shifting {
+        Shifting::None => None,
+        Shifting::Xu { coefficient } => Some(Law::Xu(coefficient)),
+        Shifting::Fickian { coefficient } => Some(Law::Fickian(coefficient)),
+    };
+    if let Some(law) = law {
+        // The pairs are those of this step's positions (the kick moves no particle).
+        let threshold = D as f64 - 0.5;
+        stages.push(Box::new(FreeSurface { threshold }));
+        stages.push(Box::new(crate::isph::shifting::Shifting::new(law, kernel, threshold)));
+    }
     stages
 }
