@@ -118,7 +118,7 @@ impl Settings {
 /// The option sets compared: name and description. The ISPH sets are merge patches on the
 /// scheme options of the case's template (the drop's `paper` preset, the channel's `re40`);
 /// `wcsph` replaces the scheme (see [`Base::scene`]).
-pub const OPTION_SETS: [(&str, &str); 5] = [
+pub const OPTION_SETS: [(&str, &str); 6] = [
     ("xu", "Xu shifting C = 0.02, symmetric pressure gradient, Qiu's divergence (Qiu 2013)"),
     ("none", "no shifting"),
     ("xu_difference", "Xu shifting C = 0.02 with the difference pressure gradient"),
@@ -128,14 +128,15 @@ pub const OPTION_SETS: [(&str, &str); 5] = [
         "WCSPH: the drop's wcsph_tuned preset (c0 = 10 u_max, α = 0.02, δ-SPH 0.1, corrected continuity); \
          in the channel c0 = 10 × the Poiseuille centre-line speed F D²/(8ν), no artificial viscosity, δ-SPH 0.1",
     ),
+    ("wcsph_xu", "wcsph with Xu shifting C = 0.02 (scheme.wcsph.shifting)"),
 ];
 
 /// The scheme an option set runs.
 fn scheme_of(set: &str) -> &'static str {
-    if set == WCSPH { "wcsph" } else { "isph" }
+    if set.starts_with(WCSPH) { "wcsph" } else { "isph" }
 }
 
-/// The WCSPH option set's name.
+/// The WCSPH option set's name (and the prefix of its shifted variant, `wcsph_xu`).
 const WCSPH: &str = "wcsph";
 
 /// The merge patch of option set `name` (for `wcsph` only the removal of the ISPH scheme;
@@ -143,7 +144,7 @@ const WCSPH: &str = "wcsph";
 fn option_patch(name: &str) -> Option<Value> {
     Some(match name {
         "xu" => json!({}),
-        WCSPH => json!({"scheme": {"isph": null}}),
+        WCSPH | "wcsph_xu" => json!({"scheme": {"isph": null}}),
         "none" => json!({"scheme": {"isph": {"shifting": null}}}),
         "xu_difference" => json!({"scheme": {"isph": {"pressure_gradient": "difference"}}}),
         "fickian" => json!({"scheme": {"isph": {
@@ -337,7 +338,8 @@ impl Base {
         let patch = option_patch(set)
             .ok_or_else(|| HarnessError::case(NAME, format!("unknown option set `{set}`")))?;
         merge_patch(&mut v, &patch);
-        if set == WCSPH && self.short == "drop" {
+        let wcsph = scheme_of(set) == "wcsph";
+        if wcsph && self.short == "drop" {
             let preset =
                 self.case.sweep.presets.iter().find(|p| p.name == "wcsph_tuned").ok_or_else(|| {
                     HarnessError::case(NAME, format!("{} has no wcsph_tuned preset", self.case.case))
@@ -345,7 +347,7 @@ impl Base {
             merge_patch(&mut v, &preset.patch);
         }
         edit(&mut v);
-        if set == WCSPH && self.short == "channel" {
+        if wcsph && self.short == "channel" {
             let width = match self.case.reference {
                 crate::case::ReferenceSpec::PoiseuilleStartup { width, .. } => width,
                 _ => return Err(HarnessError::case(NAME, "the channel has no start-up reference")),
@@ -356,6 +358,9 @@ impl Base {
             let u_max = force * width * width / (8.0 * nu);
             v["scheme"] = json!({"wcsph": {"sound_speed": 10.0 * u_max,
                 "artificial_viscosity": {"alpha": 0.0, "beta": 0.0}, "density_diffusion": 0.1}});
+        }
+        if set == "wcsph_xu" {
+            v["scheme"]["wcsph"]["shifting"] = json!({"xu": {"coefficient": 0.02}});
         }
         Ok(v)
     }
@@ -884,25 +889,28 @@ pub fn checks(results: &StabilityResults, panics: usize) -> Vec<CheckResult> {
         0.02,
         "not run or not measurable (diverged before the first sample)",
     ));
-    // The same bounds for WCSPH (no Reynolds-number study: see `run`).
-    out.push(min(
-        "drop (wcsph): largest stable multiple of the adaptive step ≥ 1",
-        metric(row("dt_max", "elliptical_drop", WCSPH), "dt_multiple_max"),
-        1.0,
-        none,
-    ));
-    out.push(min(
-        "channel (wcsph): largest stable multiple of the adaptive step ≥ 1",
-        metric(row("dt_max", "poiseuille_periodic", WCSPH), "dt_multiple_max"),
-        1.0,
-        none,
-    ));
-    out.push(max(
-        "drop (wcsph): kinetic-energy drift of the long run ≤ 2 %",
-        metric(row("long_run", "elliptical_drop", WCSPH), "ke_drift"),
-        0.02,
-        "not run or not measurable (diverged before the first sample)",
-    ));
+    // The same bounds for WCSPH, without and with shifting (no Reynolds-number study: see
+    // `run`).
+    for set in [WCSPH, "wcsph_xu"] {
+        out.push(min(
+            &format!("drop ({set}): largest stable multiple of the adaptive step ≥ 1"),
+            metric(row("dt_max", "elliptical_drop", set), "dt_multiple_max"),
+            1.0,
+            none,
+        ));
+        out.push(min(
+            &format!("channel ({set}): largest stable multiple of the adaptive step ≥ 1"),
+            metric(row("dt_max", "poiseuille_periodic", set), "dt_multiple_max"),
+            1.0,
+            none,
+        ));
+        out.push(max(
+            &format!("drop ({set}): kinetic-energy drift of the long run ≤ 2 %"),
+            metric(row("long_run", "elliptical_drop", set), "ke_drift"),
+            0.02,
+            "not run or not measurable (diverged before the first sample)",
+        ));
+    }
     let jittered: Vec<&Row> = results
         .runs
         .iter()
@@ -952,7 +960,7 @@ mod tests {
         let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation");
         let case = Case::load(&dir.join("elliptical_drop.json")).unwrap();
         let base = Base { case, short: "drop", preset: "paper", dx: 0.04, bound: 0.02 };
-        for &(set, _) in OPTION_SETS.iter().filter(|(s, _)| *s != WCSPH) {
+        for &(set, _) in OPTION_SETS.iter().filter(|(s, _)| scheme_of(s) == "isph") {
             let v = base.scene(set, |_| {}).unwrap();
             let scene = meniscus::Scene::from_json(&v.to_string()).unwrap_or_else(|e| panic!("{set}: {e}"));
             let meniscus::scene::Scheme::Isph(o) = &scene.scheme else { panic!("{set}: not an ISPH scene") };
@@ -975,6 +983,11 @@ mod tests {
         let meniscus::scene::Scheme::Wcsph(o) = &scene.scheme else { panic!("not a WCSPH scene") };
         // u_max = F D² / (8 ν) = 6e-7 × 0.04 / 8e-6 = 3e-3 m/s (Re = 400).
         assert!((o.sound_speed - 0.03).abs() < 1e-12, "{}", o.sound_speed);
+        assert_eq!(o.shifting, meniscus::scene::Shifting::None);
+        let v = channel.scene("wcsph_xu", |_| {}).unwrap();
+        let scene = meniscus::Scene::from_json(&v.to_string()).unwrap();
+        let meniscus::scene::Scheme::Wcsph(o) = &scene.scheme else { panic!("not a WCSPH scene") };
+        assert!(matches!(o.shifting, meniscus::scene::Shifting::Xu { .. }));
     }
 
     /// The whole runner on tiny settings: every study gives its rows, the page and the
@@ -1025,7 +1038,7 @@ mod tests {
         assert!(dt.measured.starts_with("k "));
         let long = &res.runs[5];
         assert!(long.metrics["ke_drift"].is_finite() && !long.series["e"].is_empty());
-        assert!(res.complete && res.checks.len() == 9);
+        assert!(res.complete && res.checks.len() == 12);
         assert_eq!(res.checks[0].value, Some(0.0), "no panic");
         assert!(res.executed > 0 && res.reused == 0);
         let back: StabilityResults = io::read_json(&opts.out.join("stability/results.json")).unwrap();
