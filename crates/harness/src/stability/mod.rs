@@ -124,11 +124,11 @@ pub const OPTION_SETS: [(&str, &str); 6] = [
     ("xu_difference", "Xu shifting C = 0.02 with the difference pressure gradient"),
     ("fickian", "Fickian shifting A = 2 with the kernel-corrected divergence"),
     (
-        "wcsph",
+        WCSPH,
         "WCSPH: the drop's wcsph_tuned preset (c0 = 10 u_max, α = 0.02, δ-SPH 0.1, corrected continuity); \
          in the channel c0 = 10 × the Poiseuille centre-line speed F D²/(8ν), no artificial viscosity, δ-SPH 0.1",
     ),
-    ("wcsph_xu", "wcsph with Xu shifting C = 0.02 (scheme.wcsph.shifting)"),
+    (WCSPH_XU, "wcsph with Xu shifting C = 0.02 (scheme.wcsph.shifting)"),
 ];
 
 /// The scheme an option set runs.
@@ -136,15 +136,18 @@ fn scheme_of(set: &str) -> &'static str {
     if set.starts_with(WCSPH) { "wcsph" } else { "isph" }
 }
 
-/// The WCSPH option set's name (and the prefix of its shifted variant, `wcsph_xu`).
+/// The WCSPH option set's name (and the prefix of its shifted variant).
 const WCSPH: &str = "wcsph";
+
+/// The WCSPH option set with Xu shifting.
+const WCSPH_XU: &str = "wcsph_xu";
 
 /// The merge patch of option set `name` (for `wcsph` only the removal of the ISPH scheme;
 /// [`Base::scene`] adds the WCSPH options).
 fn option_patch(name: &str) -> Option<Value> {
     Some(match name {
         "xu" => json!({}),
-        WCSPH | "wcsph_xu" => json!({"scheme": {"isph": null}}),
+        WCSPH | WCSPH_XU => json!({"scheme": {"isph": null}}),
         "none" => json!({"scheme": {"isph": {"shifting": null}}}),
         "xu_difference" => json!({"scheme": {"isph": {"pressure_gradient": "difference"}}}),
         "fickian" => json!({"scheme": {"isph": {
@@ -359,7 +362,7 @@ impl Base {
             v["scheme"] = json!({"wcsph": {"sound_speed": 10.0 * u_max,
                 "artificial_viscosity": {"alpha": 0.0, "beta": 0.0}, "density_diffusion": 0.1}});
         }
-        if set == "wcsph_xu" {
+        if set == WCSPH_XU {
             v["scheme"]["wcsph"]["shifting"] = json!({"xu": {"coefficient": 0.02}});
         }
         Ok(v)
@@ -891,7 +894,7 @@ pub fn checks(results: &StabilityResults, panics: usize) -> Vec<CheckResult> {
     ));
     // The same bounds for WCSPH, without and with shifting (no Reynolds-number study: see
     // `run`).
-    for set in [WCSPH, "wcsph_xu"] {
+    for set in [WCSPH, WCSPH_XU] {
         out.push(min(
             &format!("drop ({set}): largest stable multiple of the adaptive step ≥ 1"),
             metric(row("dt_max", "elliptical_drop", set), "dt_multiple_max"),
@@ -984,7 +987,7 @@ mod tests {
         // u_max = F D² / (8 ν) = 6e-7 × 0.04 / 8e-6 = 3e-3 m/s (Re = 400).
         assert!((o.sound_speed - 0.03).abs() < 1e-12, "{}", o.sound_speed);
         assert_eq!(o.shifting, meniscus::scene::Shifting::None);
-        let v = channel.scene("wcsph_xu", |_| {}).unwrap();
+        let v = channel.scene(WCSPH_XU, |_| {}).unwrap();
         let scene = meniscus::Scene::from_json(&v.to_string()).unwrap();
         let meniscus::scene::Scheme::Wcsph(o) = &scene.scheme else { panic!("not a WCSPH scene") };
         assert!(matches!(o.shifting, meniscus::scene::Shifting::Xu { .. }));

@@ -19,7 +19,7 @@ pub mod shifting;
 
 use crate::kernel::{Kernel, Scaled};
 use crate::ppe::PpeSolve;
-use crate::scene::{IsphOptions, Scene, Shifting as ShiftSpec};
+use crate::scene::{IsphOptions, Scene};
 use crate::scene::{ViscousIntegration, ViscousOperator, WallModel};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
@@ -133,18 +133,8 @@ pub fn build_stages<K: Kernel, const D: usize>(
     }
     stages.push(Box::new(projection::Correction { form: opts.pressure_gradient }));
     stages.push(Box::new(projection::Position));
-    match opts.shifting {
-        ShiftSpec::None => {}
-        ShiftSpec::Xu { coefficient } => stages.push(Box::new(shifting::Shifting::new(
-            shifting::Law::Xu(coefficient),
-            kernel,
-            opts.free_surface_threshold,
-        ))),
-        ShiftSpec::Fickian { coefficient } => stages.push(Box::new(shifting::Shifting::new(
-            shifting::Law::Fickian(coefficient),
-            kernel,
-            opts.free_surface_threshold,
-        ))),
+    if let Some(law) = shifting::Law::of(opts.shifting) {
+        stages.push(Box::new(shifting::Shifting::new(law, kernel, opts.free_surface_threshold)));
     }
     if let Some(o) = open {
         stages.push(Box::new(OpenBoundaries::new(o)));

@@ -44,6 +44,18 @@ pub enum Law {
     Fickian(f64),
 }
 
+impl Law {
+    /// The law a scene's `shifting` option asks for (None: no shifting stage), for either
+    /// scheme.
+    pub fn of(spec: crate::scene::Shifting) -> Option<Law> {
+        match spec {
+            crate::scene::Shifting::None => None,
+            crate::scene::Shifting::Xu { coefficient } => Some(Law::Xu(coefficient)),
+            crate::scene::Shifting::Fickian { coefficient } => Some(Law::Fickian(coefficient)),
+        }
+    }
+}
+
 /// The shifting stage. It runs after the position update and reuses the step's pair
 /// geometry from r*: the particles have moved by `Δt (uⁿ⁺¹ − uⁿ)/2` since, about 1e-5 Δx
 /// in the drop, far below what the shift's heuristic resolves; recomputing the geometry

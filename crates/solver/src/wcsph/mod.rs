@@ -19,7 +19,7 @@ pub mod integrator;
 
 use crate::isph::shifting::Law;
 use crate::kernel::{Kernel, Scaled};
-use crate::scene::{Scene, Shifting, WallModel, WcsphOptions};
+use crate::scene::{Scene, WallModel, WcsphOptions};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::free_surface::FreeSurface;
@@ -106,12 +106,7 @@ pub fn build_stages<K: Kernel, const D: usize>(
     stages.push(forces::momentum(params));
     stages.extend(tension());
     stages.push(Box::new(integrator::Kick));
-    let law = match opts.shifting {
-        Shifting::None => None,
-        Shifting::Xu { coefficient } => Some(Law::Xu(coefficient)),
-        Shifting::Fickian { coefficient } => Some(Law::Fickian(coefficient)),
-    };
-    if let Some(law) = law {
+    if let Some(law) = Law::of(opts.shifting) {
         // The pairs are those of this step's positions (the kick moves no particle).
         let threshold = D as f64 - 0.5;
         stages.push(Box::new(FreeSurface { threshold }));
