@@ -488,7 +488,8 @@ impl<const D: usize> Simulation<D> {
                             // 2(D+2) against Shao–Lo's 2 on all components: its largest
                             // eigenvalue is (D+2)/D times larger, so its stable step smaller.
                             let stiffness = match opts.viscous_operator {
-                                crate::scene::ViscousOperator::ShaoLo => 1.0,
+                                crate::scene::ViscousOperator::ShaoLo
+                                | crate::scene::ViscousOperator::Consistent => 1.0,
                                 crate::scene::ViscousOperator::MonaghanCleary => (D as f64 + 2.0) / D as f64,
                             };
                             dt = dt.min(viscous * self.state.density * h * h / (mu * stiffness));

@@ -131,6 +131,10 @@ fn malformed_scene_table() {
             v["scheme"]["isph"]["viscosity"] = json!("implicit");
             v["scheme"]["isph"]["viscous_operator"] = json!("monaghan_cleary")
         }),
+        ("scheme.isph.viscous_operator", "explicit only", |v| {
+            v["scheme"]["isph"]["viscosity"] = json!("implicit");
+            v["scheme"]["isph"]["viscous_operator"] = json!("consistent")
+        }),
         ("scheme.isph.viscous_operator", "", |v| v["scheme"]["isph"]["viscous_operator"] = json!("morris")),
         ("scheme.isph.density_relaxation", "[0, 1]", |v| {
             v["scheme"]["isph"]["density_relaxation"] = json!(-0.1)

@@ -12,6 +12,7 @@
 //! `shifting` (eqs. 20–21; when configured) → `open_boundaries` (inflow/outflow only:
 //! buffer transfer).
 
+pub mod consistent_viscosity;
 pub mod implicit_viscosity;
 pub mod predictor;
 pub mod projection;
@@ -88,6 +89,9 @@ pub fn build_stages<K: Kernel, const D: usize>(
         match opts.viscous_operator {
             ViscousOperator::ShaoLo => stages.push(Box::new(predictor::Viscosity { nu })),
             ViscousOperator::MonaghanCleary => stages.push(Box::new(predictor::CentralViscosity { nu })),
+            ViscousOperator::Consistent => {
+                stages.push(Box::new(consistent_viscosity::ConsistentViscosity { nu }))
+            }
         }
     }
     if g.norm_squared() > 0.0 {

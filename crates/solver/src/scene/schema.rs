@@ -475,6 +475,12 @@ pub enum ViscousOperator {
     /// surface. Explicit integration only; its adaptive viscous step limit is `D/(D+2)`
     /// times Shao–Lo's (its largest eigenvalue is `(D+2)/D` times larger).
     MonaghanCleary,
+    /// Second-order consistent (Fatehi & Manzari 2011, Comput. Math. Appl. 61:482): the
+    /// Hessian fitted from the second differences with the kernel-corrected gradient
+    /// subtracted and its error solved for, exact for quadratic fields on any arrangement
+    /// (`isph::consistent_viscosity`). Removes the Shao–Lo operator's moment error, which
+    /// does not shrink with Δx. Explicit integration only; not momentum-conserving.
+    Consistent,
 }
 
 /// Time integration of the viscous term of the predictor (Qiu 2013 eq. 4).

@@ -240,10 +240,14 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
             "must lie in [0, 1] (0: off; 0.01–0.1 relaxes a density drift over 10–100 steps)",
         ));
     }
-    if o.viscosity == ViscousIntegration::Implicit && o.viscous_operator == ViscousOperator::MonaghanCleary {
+    if o.viscosity == ViscousIntegration::Implicit && o.viscous_operator != ViscousOperator::ShaoLo {
+        let name = match o.viscous_operator {
+            ViscousOperator::MonaghanCleary => "monaghan_cleary",
+            _ => "consistent",
+        };
         return Err(SceneError::new(
             "scheme.isph.viscous_operator",
-            "monaghan_cleary",
+            name,
             "is explicit only: the implicit viscous solve uses the shao_lo operator",
         ));
     }
