@@ -50,15 +50,29 @@ impl PpeMatrix {
         y.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, yi)| *yi = self.row_dot(i, x));
     }
 
-    /// (A x)_i, summed over the row's entries in their stored order.
+    /// (A x)_i: the row's entries in their stored order dealt round-robin to four partial
+    /// sums, added as (s₀ + s₁) + (s₂ + s₃) (a fixed order: the result does not depend on
+    /// the thread count).
+    ///
+    /// One running sum chains every addition to the previous one (its latency, not the
+    /// loads, then sets the pace); four independent sums overlap them. Measured on the drop
+    /// at Δx = 0.02, one thread: 0.484 → 0.435 ms per BiCGSTAB iteration (−10 %).
     #[inline]
     pub fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
         let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
-        let mut acc = 0.0;
-        for (&c, &v) in self.cols[s..e].iter().zip(&self.vals[s..e]) {
-            acc += v * x[c as usize];
+        let (cols, vals) = (&self.cols[s..e], &self.vals[s..e]);
+        let mut acc = [0.0; 4];
+        let (cq, cr) = cols.as_chunks::<4>();
+        let (vq, vr) = vals.as_chunks::<4>();
+        for (c, v) in cq.iter().zip(vq) {
+            for k in 0..4 {
+                acc[k] += v[k] * x[c[k] as usize];
+            }
         }
-        acc
+        for (k, (&c, &v)) in cr.iter().zip(vr).enumerate() {
+            acc[k] += v * x[c as usize];
+        }
+        (acc[0] + acc[1]) + (acc[2] + acc[3])
     }
 
     /// Sizes the entry arrays for the row offsets already in `row_ptr`.
