@@ -483,6 +483,17 @@ pub enum ViscousOperator {
     Consistent,
 }
 
+impl ViscousOperator {
+    /// The operator's name in a scene file (its serde name).
+    pub fn scene_name(self) -> &'static str {
+        match self {
+            ViscousOperator::ShaoLo => "shao_lo",
+            ViscousOperator::MonaghanCleary => "monaghan_cleary",
+            ViscousOperator::Consistent => "consistent",
+        }
+    }
+}
+
 /// Time integration of the viscous term of the predictor (Qiu 2013 eq. 4).
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -711,4 +722,18 @@ impl Default for OutputSpec {
 
 fn default_probe_every() -> usize {
     10
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ViscousOperator;
+
+    /// Error messages name an operator as the scene file spells it.
+    #[test]
+    fn viscous_operator_scene_names_are_the_serde_names() {
+        for op in [ViscousOperator::ShaoLo, ViscousOperator::MonaghanCleary, ViscousOperator::Consistent] {
+            let json = serde_json::to_string(&op).expect("serialises");
+            assert_eq!(json, format!("\"{}\"", op.scene_name()));
+        }
+    }
 }

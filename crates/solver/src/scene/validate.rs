@@ -241,13 +241,9 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
         ));
     }
     if o.viscosity == ViscousIntegration::Implicit && o.viscous_operator != ViscousOperator::ShaoLo {
-        let name = match o.viscous_operator {
-            ViscousOperator::MonaghanCleary => "monaghan_cleary",
-            _ => "consistent",
-        };
         return Err(SceneError::new(
             "scheme.isph.viscous_operator",
-            name,
+            o.viscous_operator.scene_name(),
             "is explicit only: the implicit viscous solve uses the shao_lo operator",
         ));
     }
