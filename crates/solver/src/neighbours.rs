@@ -223,10 +223,11 @@ impl<const D: usize> CellSearch<D> {
     }
 
     /// A permutation `perm` (new index → old index) that orders particles by cell, for
-    /// memory locality; apply it to every particle array.
-    pub fn cell_order(&mut self, x: &[SVector<f64, D>]) -> Vec<u32> {
+    /// memory locality; apply it to every particle array. Borrowed from the search's own
+    /// buffer (valid until its next call).
+    pub fn cell_order(&mut self, x: &[SVector<f64, D>]) -> &[u32] {
         self.bin(x);
-        self.sorted.clone()
+        &self.sorted
     }
 
     /// Builds the neighbour lists of all particles at positions `x` into `list`.
@@ -532,7 +533,7 @@ mod tests {
         let x: Vec<SVector<f64, 2>> =
             (0..300).map(|_| SVector::from_fn(|_, _| rng.random_range(-1.0..1.0))).collect();
         let mut s = CellSearch::new(0.1, Domain::default());
-        let mut p = s.cell_order(&x);
+        let mut p = s.cell_order(&x).to_vec();
         p.sort_unstable();
         assert!(p.iter().enumerate().all(|(i, &v)| v as usize == i));
     }

@@ -182,24 +182,36 @@ impl<const D: usize> State<D> {
     }
 
     /// Applies the permutation `perm` (new → old) of the fluid particles to every particle
-    /// array (the leading `perm.len()` entries; boundary particles keep their place).
-    pub fn permute(&mut self, perm: &[u32]) {
-        fn apply<T: Copy>(v: &mut [T], perm: &[u32]) {
+    /// array (the leading `perm.len()` entries; boundary particles keep their place),
+    /// through the reusable buffers of `scratch` (no allocation once they are warm).
+    pub fn permute(&mut self, perm: &[u32], scratch: &mut PermuteScratch<D>) {
+        fn apply<T: Copy>(v: &mut [T], perm: &[u32], tmp: &mut Vec<T>) {
             if v.len() >= perm.len() {
-                let new: Vec<T> = perm.iter().map(|&i| v[i as usize]).collect();
-                v[..perm.len()].copy_from_slice(&new);
+                tmp.clear();
+                tmp.extend(perm.iter().map(|&i| v[i as usize]));
+                v[..perm.len()].copy_from_slice(tmp);
             }
         }
-        apply(&mut self.particles.id, perm);
-        apply(&mut self.particles.x, perm);
-        apply(&mut self.particles.u, perm);
-        apply(&mut self.particles.p, perm);
-        apply(&mut self.x_old, perm);
-        apply(&mut self.u_old, perm);
-        apply(&mut self.free_surface, perm);
-        apply(&mut self.div_r, perm);
-        apply(&mut self.wc.rho, perm);
-        apply(&mut self.wc.drho, perm);
-        apply(&mut self.wc.accel, perm);
+        let PermuteScratch { ids, vectors, scalars, flags } = scratch;
+        apply(&mut self.particles.id, perm, ids);
+        apply(&mut self.particles.x, perm, vectors);
+        apply(&mut self.particles.u, perm, vectors);
+        apply(&mut self.particles.p, perm, scalars);
+        apply(&mut self.x_old, perm, vectors);
+        apply(&mut self.u_old, perm, vectors);
+        apply(&mut self.free_surface, perm, flags);
+        apply(&mut self.div_r, perm, scalars);
+        apply(&mut self.wc.rho, perm, scalars);
+        apply(&mut self.wc.drho, perm, scalars);
+        apply(&mut self.wc.accel, perm, vectors);
     }
+}
+
+/// Reusable buffers of [`State::permute`], one per element type.
+#[derive(Debug, Clone, Default)]
+pub struct PermuteScratch<const D: usize> {
+    ids: Vec<u32>,
+    vectors: Vec<Vector<D>>,
+    scalars: Vec<f64>,
+    flags: Vec<bool>,
 }

@@ -3,7 +3,7 @@
 use crate::error::Cause;
 use crate::neighbours::{CellSearch, Domain};
 use crate::stage::{Stage, StepContext};
-use crate::state::State;
+use crate::state::{PermuteScratch, State};
 
 /// Every `every` steps (from the first), permutes the fluid particles into cell order.
 /// Boundary particles are rebuilt after it (the wall stage comes later in the step), so
@@ -13,12 +13,18 @@ pub struct Reorder<const D: usize> {
     search: CellSearch<D>,
     every: usize,
     calls: usize,
+    scratch: PermuteScratch<D>,
 }
 
 impl<const D: usize> Reorder<D> {
     /// Reorders every `every` steps on cells of size `cell` \[m\] (the kernel support).
     pub fn new(cell: f64, domain: Domain<D>, every: usize) -> Self {
-        Self { search: CellSearch::new(cell, domain), every: every.max(1), calls: 0 }
+        Self {
+            search: CellSearch::new(cell, domain),
+            every: every.max(1),
+            calls: 0,
+            scratch: PermuteScratch::default(),
+        }
     }
 }
 
@@ -30,7 +36,7 @@ impl<const D: usize> Stage<D> for Reorder<D> {
     fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
         if self.calls.is_multiple_of(self.every) {
             let perm = self.search.cell_order(&s.particles.x[..s.particles.fluid]);
-            s.permute(&perm);
+            s.permute(perm, &mut self.scratch);
         }
         self.calls += 1;
         Ok(())
