@@ -16,9 +16,9 @@ use std::alloc::System;
 static GLOBAL: &StatsAlloc<System> = &INSTRUMENTED_SYSTEM;
 
 /// (fresh allocations, reallocations) during `steps` steps of `scene` after `warm` steps,
-/// on a one-thread pool built beforehand (its own start-up is not the step's).
-fn heap_traffic(scene: &meniscus::Scene, warm: usize, steps: usize) -> (usize, usize) {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("pool");
+/// on a pool of `threads` built beforehand (its own start-up is not the step's).
+fn heap_traffic(scene: &meniscus::Scene, warm: usize, steps: usize, threads: usize) -> (usize, usize) {
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("pool");
     pool.install(|| {
         let mut s = Stepper::<2>::new(scene).expect("scene builds");
         for _ in 0..warm {
@@ -33,33 +33,39 @@ fn heap_traffic(scene: &meniscus::Scene, warm: usize, steps: usize) -> (usize, u
     })
 }
 
+/// One test function for both scenes: the statistics are global, so a second test running
+/// beside this one would be counted in its steps.
 #[test]
-fn a_warm_drop_step_does_not_allocate() {
+fn a_warm_step_does_not_allocate() {
+    drop_steps();
+    walled_periodic_channel_steps();
+}
+
+fn drop_steps() {
     let scene = common::drop_scene(|v| {
         v["dx"] = json!(0.05);
         v["time"]["end"] = json!(1.0);
     });
     // 60 steps span two cell reorders (every 25 steps), which once allocated their
     // permutation and a copy of every particle array.
-    let (fresh, grown) = heap_traffic(&scene, 30, 60);
-    assert_eq!(fresh, 0, "{fresh} allocations in 60 warm steps of the drop");
-    // The drop stretches: its cell grid (one count and one offset per cell) outgrows its
-    // capacity about once here (two reallocations of ~1.5 kB, measured).
-    assert!(grown <= 2, "{grown} reallocations in 60 warm steps of the drop");
+    for threads in [1, 2] {
+        let (fresh, grown) = heap_traffic(&scene, 30, 60, threads);
+        assert_eq!(fresh, 0, "{fresh} allocations in 60 warm steps of the drop, {threads} threads");
+        // The drop stretches: its cell grid (one count and one offset per cell) outgrows
+        // its capacity about once here (two reallocations of ~1.5 kB, measured).
+        assert!(grown <= 2, "{grown} reallocations in 60 warm steps of the drop, {threads} threads");
+    }
 }
 
-#[test]
-fn a_warm_walled_periodic_channel_step_does_not_allocate() {
+fn walled_periodic_channel_steps() {
     let case: Value = serde_json::from_str(include_str!("../../../validation/poiseuille_periodic.json"))
         .expect("case JSON");
     let mut v = case["scene"].clone();
     v["dx"] = json!(0.2 / 18.0);
     v["body_force"] = json!([6e-8, 0.0]);
     let scene = meniscus::Scene::from_json(&v.to_string()).expect("valid scene");
-    let (fresh, grown) = heap_traffic(&scene, 30, 60);
-    assert_eq!(
-        (fresh, grown),
-        (0, 0),
-        "heap traffic in 60 warm steps of the channel (mirror walls, periodic x)"
-    );
+    for threads in [1, 2] {
+        let traffic = heap_traffic(&scene, 30, 60, threads);
+        assert_eq!(traffic, (0, 0), "heap traffic in 60 warm steps of the channel, {threads} threads");
+    }
 }
