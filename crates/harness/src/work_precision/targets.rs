@@ -171,12 +171,21 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
     let issue_range =
         if finest_dx > 0.005 + 1e-12 { "; the issue's range 0.04 → 0.005 needs --full" } else { "" };
     for fit in cost_fits(runs, threads) {
-        let note = match fit.exponent {
-            Some(_) => format!(
-                "least squares in log-log over {} spacings ({range}{issue_range}), {threads} threads",
-                fit.dx.len()
-            ),
-            None => format!("fewer than two finished spacings ({range})"),
+        let note = match (fit.exponent, fit.dx.first(), fit.dx.last()) {
+            (Some(_), Some(&coarse), Some(&fine)) => {
+                // A spacing of the tier that diverged is not in the fit: say so.
+                let missing = if fine > finest_dx + 1e-12 {
+                    format!("; Δx = {finest_dx} did not finish")
+                } else {
+                    String::new()
+                };
+                format!(
+                    "least squares in log-log over {} spacings (Δx {coarse} → {fine}{missing}{issue_range}), \
+                     {threads} threads",
+                    fit.dx.len()
+                )
+            }
+            _ => format!("fewer than two finished spacings ({range})"),
         };
         out.push(max_target(
             format!("cost-per-step exponent vs particles ≤ {COST_EXPONENT} ({} preset)", fit.preset),
@@ -281,6 +290,25 @@ mod tests {
         assert_eq!((ts[1].value, ts[1].pass), (None, Some(false)), "no run reaching 0.5 % is a fail");
         assert_eq!(ts[4].pass, None);
         assert!(ts[4].note.contains("not in this tier"));
+    }
+
+    /// The fit's note names the spacings it covers, and a finest spacing that diverged.
+    #[test]
+    fn the_cost_fit_says_which_spacings_it_covers() {
+        let p = Some(Variant::PAPER);
+        let mut runs = vec![
+            row(p, 0.04, 2, 0.4, Some(0.007)),
+            row(p, 0.02, 2, 1.6, Some(0.003)),
+            row(p, 0.01, 2, 6.4, Some(0.008)),
+        ];
+        runs[2].status = "diverged: guard at step 870".into();
+        let ts = evaluate(&runs, 2, 0.01);
+        assert!((ts[2].value.unwrap() - 1.0).abs() < 1e-2, "{:?}", ts[2]);
+        assert!(
+            ts[2].note.contains("over 2 spacings (Δx 0.04 → 0.02; Δx = 0.01 did not finish"),
+            "{}",
+            ts[2].note
+        );
     }
 
     #[test]
