@@ -244,7 +244,10 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
         return Err(SceneError::new(
             "scheme.isph.viscous_operator",
             o.viscous_operator.scene_name(),
-            "is explicit only: the implicit viscous solve uses the shao_lo operator",
+            format!(
+                "is explicit only: the implicit viscous solve uses the {} operator",
+                ViscousOperator::ShaoLo.scene_name()
+            ),
         ));
     }
     validate_shifting("scheme.isph.shifting", o.shifting)?;
