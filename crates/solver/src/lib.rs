@@ -24,6 +24,7 @@ pub mod stage;
 pub mod stages;
 pub mod state;
 pub mod two_level;
+pub mod warm_pool;
 pub mod wcsph;
 
 pub use error::{Cause, SceneError, SolverError};

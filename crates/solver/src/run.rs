@@ -353,12 +353,13 @@ impl<const D: usize> Simulation<D> {
     ///
     /// The step loop runs on a worker thread of the current rayon pool, so the parallel
     /// loops of the stages start without a hand-over from an outside thread (measured:
-    /// 12 % of a single-thread run went to futex waits before).
+    /// 12 % of a single-thread run went to futex waits before), and the pool's other
+    /// threads are kept polling for work meanwhile ([`crate::warm_pool`]).
     pub fn run(&mut self, observer: &mut dyn Observer) -> RunReport {
         if rayon::current_thread_index().is_some() {
-            self.run_on_worker(observer)
+            crate::warm_pool::with_warm_workers(|| self.run_on_worker(observer))
         } else {
-            rayon::scope(|_| self.run_on_worker(observer))
+            rayon::scope(|_| crate::warm_pool::with_warm_workers(|| self.run_on_worker(observer)))
         }
     }
 
