@@ -41,7 +41,13 @@ impl ImplicitViscosity {
             max_iterations: 2000,
             preconditioner: Preconditioner::Jacobi,
         };
-        Self { nu, matrix: PpeMatrix::default(), solver: PpeSolve::new(opts), rhs: Vec::new(), x: Vec::new() }
+        Self {
+            nu,
+            matrix: PpeMatrix::default(),
+            solver: PpeSolve::new(opts).measuring_residual(false),
+            rhs: Vec::new(),
+            x: Vec::new(),
+        }
     }
 }
 

@@ -20,7 +20,7 @@ pub mod shifting;
 
 use crate::kernel::{Kernel, Scaled};
 use crate::ppe::PpeSolve;
-use crate::scene::{IsphOptions, Scene};
+use crate::scene::{IsphOptions, Probe, Scene};
 use crate::scene::{ViscousIntegration, ViscousOperator, WallModel};
 use crate::stage::Stage;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
@@ -128,10 +128,10 @@ pub fn build_stages<K: Kernel, const D: usize>(
         dt_max: 0.0,
         surface_pressure: young_laplace,
     }));
-    stages.push(Box::new(projection::PpeSolveStage {
-        solver: PpeSolve::new(opts.ppe),
-        surface_pressure: young_laplace,
-    }));
+    // Only a `solver` probe reads the measured residual.
+    let solver = PpeSolve::new(opts.ppe)
+        .measuring_residual(scene.probes.iter().any(|p| matches!(p, Probe::Solver {})));
+    stages.push(Box::new(projection::PpeSolveStage { solver, surface_pressure: young_laplace }));
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Pressure)));
     }
