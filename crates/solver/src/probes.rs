@@ -203,10 +203,16 @@ impl<const D: usize> ProbeSet<D> {
                     out.push(key, "iterations", s.ppe.info.iterations as f64);
                     // Measured whenever the scene has this probe (the run driver asks for it).
                     out.push(key, "residual", s.ppe.info.residual.unwrap_or(f64::NAN));
+                    out.push(key, "p_max", largest_magnitude(&s.particles.p[..nf]));
                 }
             }
         }
     }
+}
+
+/// Largest |v| over `values`, NaN if any is NaN (`f64::max` would skip it), 0 when empty.
+fn largest_magnitude(values: &[f64]) -> f64 {
+    values.iter().map(|v| v.abs()).fold(0.0, |m, v| if v > m || v.is_nan() { v } else { m })
 }
 
 /// Smallest pair distance \[m\] (Δx when no pair is closer) and the fraction of particles

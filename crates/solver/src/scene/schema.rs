@@ -645,7 +645,11 @@ pub enum Probe {
     Momentum {},
     /// Particle disorder: `min_pair_over_dx`, `close_fraction` (neighbour closer than 0.5 Δx).
     Disorder {},
-    /// Free-surface particle count `count`, PPE iterations `iterations` and residual `residual`.
+    /// Solver state: the free-surface particle count `free_surface_count`, the last PPE
+    /// solve's `iterations` and relative residual `residual` (‖b − A p‖ / ‖b‖), and `p_max`,
+    /// the largest |p| over the fluid \[Pa\]. A projection that turns unstable shows here
+    /// first: p_max growing several times per step with the iterations while the flow is
+    /// still smooth (ARCHITECTURE.md, the paper drop preset at Δx = 0.005).
     Solver {},
     /// Mass balance of an open channel (`boundaries.inflow`): the fluid mass in the domain
     /// `mass` and the cumulative masses that entered, `inflow`, and left, `outflow`
