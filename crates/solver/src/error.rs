@@ -83,7 +83,7 @@ pub enum Cause {
     /// step: the neighbour lists cannot follow them (a fixed step far beyond the CFL limit,
     /// or velocities blowing up).
     #[error(
-        "particle {particle} at {} m and its neighbour {neighbour} move at {speed:.4e} m/s relative to each other: {:.4e} m in the step of {dt:.4e} s, farther than the kernel support {support:.4e} m, so the neighbour lists cannot follow them (lower time.step, or use an adaptive step){}",
+        "particle {particle} at {} m and its neighbour {neighbour} move at {speed:.4e} m/s relative to each other: {:.4e} m in the step of {dt:.4e} s, farther than the kernel support {support:.4e} m, so the neighbour lists cannot follow them (if the flow is that fast, lower time.step or use an adaptive step; velocities that grew over a few steps point to an instability instead, which a shorter step need not cure: the probes up to this step show it){}",
         point(position), speed * dt, others_note(*others)
     )]
     Overstep {
