@@ -136,6 +136,7 @@ impl ChannelVariant {
                 ChannelShift::Xu002 => 0.02,
                 ChannelShift::Xu001 => 0.01,
             },
+            smooth: false,
         };
         (o.ppe.solver, o.ppe.tolerance) = match self.ppe {
             ChannelPpe::Bicgstab => (PpeSolver::Bicgstab, 1e-3),
@@ -352,7 +353,7 @@ mod tests {
         )
         .unwrap();
         let Scheme::Isph(o) = &s.scheme else { panic!("an ISPH scene") };
-        assert_eq!(o.shifting, Shifting::Xu { coefficient: 0.01 });
+        assert_eq!(o.shifting, Shifting::Xu { coefficient: 0.01, smooth: false });
         assert_eq!(o.ppe.solver, PpeSolver::Cg);
         assert_eq!(o.viscosity, ViscousIntegration::Implicit);
     }

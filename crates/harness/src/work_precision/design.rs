@@ -208,7 +208,7 @@ impl Variant {
         };
         o.shifting = match self.shifting {
             Shift::None => Shifting::None,
-            Shift::Xu => Shifting::Xu { coefficient: 0.02 },
+            Shift::Xu => Shifting::Xu { coefficient: 0.02, smooth: false },
             Shift::Fickian => Shifting::Fickian { coefficient: 2.0 },
         };
         if self.dt == Dt::Adaptive {

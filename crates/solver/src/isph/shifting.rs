@@ -2,6 +2,9 @@
 //!
 //! - Xu et al. 2009 (Qiu eqs. 20–21): `δr_a = C Δt u_max Σ_b (r̄_a² / r_ab²) n_ab`,
 //!   `n_ab = r_ab / r_ab`, `r̄_a` the mean neighbour distance (neighbours within the support).
+//!   Smooth variant (`smooth: true`): every term of the sum and of the mean is weighted by
+//!   `w_ab = (1 − r_ab²/(2h)²)²`, `r̄_a = Σ w r / Σ w`, so that the shift goes continuously to
+//!   the published one's values inside and has no jump when a pair crosses the support.
 //! - Lind et al. 2012 (Fickian): `δr_a = −A h |u_a| Δt ∇C_a`, `∇C_a = Σ_b V_b ∇_aW_ab`.
 //!
 //! Free surface: both formulas push particles near the surface outward (their support
@@ -38,8 +41,13 @@ pub const MAX_SHIFT: f64 = 0.2;
 /// Which shifting law.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Law {
-    /// Xu 2009 with coefficient C.
-    Xu(f64),
+    /// Xu 2009 with coefficient C, smooth at the support or as published.
+    Xu {
+        /// C.
+        coefficient: f64,
+        /// Weights `(1 − r²/(2h)²)²` on the sum and the mean distance.
+        smooth: bool,
+    },
     /// Lind 2012 Fickian with coefficient A.
     Fickian(f64),
 }
@@ -50,7 +58,7 @@ impl Law {
     pub fn of(spec: crate::scene::Shifting) -> Option<Law> {
         match spec {
             crate::scene::Shifting::None => None,
-            crate::scene::Shifting::Xu { coefficient } => Some(Law::Xu(coefficient)),
+            crate::scene::Shifting::Xu { coefficient, smooth } => Some(Law::Xu { coefficient, smooth }),
             crate::scene::Shifting::Fickian { coefficient } => Some(Law::Fickian(coefficient)),
         }
     }
@@ -90,7 +98,11 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
         let (k, law, dt, v, dom) = (self.kernel, self.law, ctx.dt, s.volume, s.domain);
         let (u, list, pairs) = (&s.particles.u, &s.neighbours, &s.pairs);
         let (div_r, threshold, cap) = (&s.div_r, self.threshold, MAX_SHIFT * s.dx);
-        let xu = matches!(law, Law::Xu(_));
+        let (xu, smooth) = match law {
+            Law::Xu { smooth, .. } => (true, smooth),
+            Law::Fickian(_) => (false, false),
+        };
+        let inv_support2 = 1.0 / (k.support * k.support);
         self.shift.par_iter_mut().zip(self.du.par_iter_mut()).enumerate().with_min_len(128).for_each(
             |(a, (shift, du))| {
                 let mut grad_c = Vector::<D>::zeros();
@@ -98,7 +110,7 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
                 let mut m = SMatrix::<f64, D, D>::zeros();
                 let mut xu_sum = Vector::<D>::zeros();
                 let mut r_sum = 0.0;
-                let mut count = 0usize;
+                let mut w_sum = 0.0;
                 let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
                 for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                     if p.r2 == 0.0 {
@@ -111,17 +123,24 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
                     if xu {
                         // n_ab / r_ab² (r̄² applied after the loop).
                         let r = p.r2.sqrt();
-                        xu_sum += p.r_ab / (p.r2 * r);
-                        r_sum += r;
-                        count += 1;
+                        if smooth {
+                            let w = (1.0 - p.r2 * inv_support2).max(0.0).powi(2);
+                            xu_sum += p.r_ab * (w / (p.r2 * r));
+                            r_sum += w * r;
+                            w_sum += w;
+                        } else {
+                            xu_sum += p.r_ab / (p.r2 * r);
+                            r_sum += r;
+                            w_sum += 1.0;
+                        }
                     }
                 }
                 let mut d = match law {
-                    Law::Xu(c) if count > 0 => {
-                        let rbar = r_sum / count as f64;
+                    Law::Xu { coefficient: c, .. } if w_sum > 0.0 => {
+                        let rbar = r_sum / w_sum;
                         xu_sum * (c * dt * u_max * rbar * rbar)
                     }
-                    Law::Xu(_) => Vector::zeros(),
+                    Law::Xu { .. } => Vector::zeros(),
                     Law::Fickian(c) => -grad_c * (c * k.h * u[a].norm() * dt),
                 };
                 // Near the surface: scale by (div r − t)/(D − t) in [0, 1]; surface particles

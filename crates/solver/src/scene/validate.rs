@@ -259,7 +259,7 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
 fn validate_shifting(field: &str, shifting: Shifting) -> Result<(), SceneError> {
     match shifting {
         Shifting::None => {}
-        Shifting::Xu { coefficient } => {
+        Shifting::Xu { coefficient, .. } => {
             let f = format!("{field}.xu.coefficient");
             positive(&f, coefficient)?;
             if coefficient > 1.0 {
