@@ -3,8 +3,8 @@
 //! - Xu et al. 2009 (Qiu eqs. 20–21): `δr_a = C Δt u_max Σ_b (r̄_a² / r_ab²) n_ab`,
 //!   `n_ab = r_ab / r_ab`, `r̄_a` the mean neighbour distance (neighbours within the support).
 //!   Smooth variant (`smooth: true`): every term of the sum and of the mean is weighted by
-//!   `w_ab = (1 − r_ab²/(2h)²)²`, `r̄_a = Σ w r / Σ w`, so that the shift goes continuously to
-//!   the published one's values inside and has no jump when a pair crosses the support.
+//!   `w_ab = (1 − r_ab²/(2h)²)²`, `r̄_a = Σ w r / Σ w`, so that the shift is continuous in
+//!   the positions; the published law jumps when a pair crosses the support.
 //! - Lind et al. 2012 (Fickian): `δr_a = −A h |u_a| Δt ∇C_a`, `∇C_a = Σ_b V_b ∇_aW_ab`.
 //!
 //! Free surface: both formulas push particles near the surface outward (their support
