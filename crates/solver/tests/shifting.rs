@@ -40,31 +40,16 @@ fn fickian_shifting_keeps_a_translating_drop_round() {
 /// `poiseuille_periodic` quick scene) at 0.05 D²/ν between the lattice and the lattice with
 /// every particle displaced by at most 1e-12 Δx, over u_max.
 fn bit_sensitivity(shifting: serde_json::Value) -> f64 {
-    const D: f64 = 0.2;
     let run = |jitter: Option<f64>| {
-        let mut body =
-            json!({ "role": "fluid", "shape": { "rectangle": { "min": [0.0, 0.0], "max": [0.1, D] } } });
-        if let Some(fraction) = jitter {
-            body["jitter"] = json!({"fraction": fraction, "seed": 1});
-        }
-        let v = json!({
-            "name": "channel", "dimension": 2, "dx": D / 36.0,
-            "kernel": { "kind": "cubic_spline", "h_over_dx": 1.5 },
-            "fluid": { "density": 1000.0, "viscosity": 1e-3 },
-            "body_force": [6e-9, 0.0],
-            "bodies": [body],
-            "boundaries": {
-                "periodic": [ { "axis": 0, "min": 0.0, "max": 0.1 } ],
-                "walls": [ { "axis": 1, "position": 0.0, "fluid_side": "above" },
-                           { "axis": 1, "position": D, "fluid_side": "below" } ]
-            },
-            "scheme": { "isph": { "ppe": { "solver": "bicgstab", "tolerance": 1e-3, "max_iterations": 2000 },
-                                  "free_surface_threshold": 1.5, "shifting": shifting } },
-            "time": { "end": 2000.0, "step": { "adaptive": { "cfl": 0.2, "viscous": 0.2, "max": 100.0 } } },
-            "probes": [ { "velocity_profile": { "axis": 1, "component": 0, "range": [0.0, D] } } ],
-            "output": { "probe_every": 100000 }
+        let scene = common::periodic_channel_scene(|v| {
+            v["body_force"] = json!([6e-9, 0.0]);
+            if let Some(fraction) = jitter {
+                v["bodies"][0]["jitter"] = json!({"fraction": fraction, "seed": 1});
+            }
+            v["scheme"]["isph"]["shifting"] = shifting.clone();
+            v["time"]["end"] = json!(2000.0);
+            v["output"] = json!({"probe_every": 100000});
         });
-        let scene = meniscus::Scene::from_json(&v.to_string()).expect("valid scene");
         let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
         assert!(report.error.is_none(), "{:?}", report.error);
         (0..36)

@@ -12,3 +12,15 @@ pub fn drop_scene(edit: impl FnOnce(&mut serde_json::Value)) -> Scene {
     edit(&mut v);
     Scene::from_json(&v.to_string()).expect("valid scene")
 }
+
+/// The `poiseuille_periodic` case file (CASES.md): its `scene` is the quick tier's channel.
+pub const PERIODIC_CHANNEL_CASE: &str = include_str!("../../../../validation/poiseuille_periodic.json");
+
+/// The periodic channel scene of `validation/poiseuille_periodic.json` (Re = 40, D/36) with
+/// `edit` applied to its JSON value.
+pub fn periodic_channel_scene(edit: impl FnOnce(&mut serde_json::Value)) -> Scene {
+    let case: serde_json::Value = serde_json::from_str(PERIODIC_CHANNEL_CASE).expect("case JSON");
+    let mut v = case["scene"].clone();
+    edit(&mut v);
+    Scene::from_json(&v.to_string()).expect("valid scene")
+}
