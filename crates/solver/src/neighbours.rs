@@ -1,8 +1,8 @@
-//! Neighbour search: cell lists (cell ≥ search radius), CSR neighbour lists, parallel.
+//! Neighbour search: cell lists (cell ≥ half the search radius), CSR neighbour lists, parallel.
 //!
 //! Every particle gets its own full list (pairs stored both ways), so parallel loops over
 //! particles write only their own particle: no atomics, and the result does not depend on
-//! the thread count. Cost is O(N): each particle scans the 3^D cells around its own.
+//! the thread count. Cost is O(N): each particle scans the 5^D cells around its own.
 //! Periodic axes wrap the cell grid and use the minimum-image displacement ([`Domain`]).
 
 use nalgebra::SVector;
@@ -108,6 +108,12 @@ pub struct CellSearch<const D: usize> {
 /// Cap on the cell grid: at most this many cells per particle.
 const MAX_CELLS_PER_PARTICLE: usize = 8;
 
+/// Cells per search radius: cells of at least `radius / REACH`, and the candidates of a
+/// particle are the (2 REACH + 1)^D cells around its own. Half-radius cells (REACH = 2) scan
+/// 6.25 r² instead of 9 r² in 2D (15.6 r³ instead of 27 r³ in 3D): about a third fewer
+/// distance tests, for 5 instead of 3 contiguous row runs per row of cells in 2D.
+const REACH: isize = 2;
+
 /// Rows per parallel task when filling the lists.
 const CHUNK: usize = 512;
 
@@ -142,13 +148,14 @@ impl<const D: usize> CellSearch<D> {
             lo = lo.inf(p);
             hi = hi.sup(p);
         }
-        // Cells of at least the search radius; larger when the particles are spread so far
+        // Cells of at least radius / REACH; larger when the particles are spread so far
         // (a run blowing up) that the grid would exceed MAX_CELLS_PER_PARTICLE cells per
         // particle: the search stays correct, only slower, until the guard stops the run.
+        let cell = self.radius / REACH as f64;
         let extent: f64 = (0..D)
             .map(|k| match self.domain.periodic[k] {
-                Some((a, b)) => (b - a) / self.radius,
-                None => (hi[k] - lo[k]) / self.radius + 1.0,
+                Some((a, b)) => (b - a) / cell,
+                None => (hi[k] - lo[k]) / cell + 1.0,
             })
             // An extent beyond f64 (particles ~1e308 m apart) counts as the largest one.
             .map(|c| {
@@ -163,7 +170,7 @@ impl<const D: usize> CellSearch<D> {
             .product();
         let limit = (MAX_CELLS_PER_PARTICLE * x.len().max(1)) as f64;
         let scale = if extent > limit { (extent / limit).powf(1.0 / D as f64) } else { 1.0 };
-        let size = self.radius * scale;
+        let size = cell * scale;
         for k in 0..D {
             if let Some((a, b)) = self.domain.periodic[k] {
                 // Whole number of cells per period, each at least `size`.
@@ -180,8 +187,8 @@ impl<const D: usize> CellSearch<D> {
         }
         // A spread along one axis only (one particle flung far away) still exceeds the cap
         // after the isotropic scaling: shrink the longest axis. Particles beyond the last
-        // cell are clamped into it, which keeps every pair within the radius in adjacent
-        // cells (the search stays correct); periodic axes get wider cells instead.
+        // cell are clamped into it, which keeps every pair within the radius at most REACH
+        // cells apart (the search stays correct); periodic axes get wider cells instead.
         loop {
             let total: f64 = self.dims.iter().map(|&d| d as f64).product();
             if total <= limit {
@@ -310,26 +317,27 @@ impl<const D: usize> CellSearch<D> {
         }
     }
 
-    /// Calls `f` with runs of `sorted` that together hold every particle in the 3^D cells
-    /// around `p` (each particle once), in the order of [`Self::visit_cells`].
+    /// Calls `f` with runs of `sorted` that together hold every particle in the
+    /// (2 REACH + 1)^D cells around `p` (each particle once), in the order of
+    /// [`Self::visit_cells`].
     ///
-    /// Axis 0 varies fastest in the cell id, so the (up to) three cells of one row around
-    /// `p` are consecutive ids and their particles one contiguous run of `sorted`: one
-    /// range per row of cells (3^(D−1) ranges) instead of one per cell. A row that wraps
+    /// Axis 0 varies fastest in the cell id, so the (up to) 2 REACH + 1 cells of one row
+    /// around `p` are consecutive ids and their particles one contiguous run of `sorted`:
+    /// one range per row of cells ((2 REACH + 1)^(D−1) ranges) instead of one per cell. A row that wraps
     /// around a periodic axis 0 is not contiguous and goes cell by cell.
     #[inline]
     fn visit_candidates(&self, p: &SVector<f64, D>, mut f: impl FnMut(&[u32])) {
         let base = self.cell_index(p);
         let d0 = self.dims[0] as isize;
         let (lo0, hi0) = if self.domain.periodic[0].is_some() {
-            if d0 < 3 || base[0] < 1 || base[0] + 1 >= d0 {
+            if d0 < 2 * REACH + 1 || base[0] < REACH || base[0] + REACH >= d0 {
                 return self.visit_cells(&base, f);
             }
-            (base[0] - 1, base[0] + 1)
+            (base[0] - REACH, base[0] + REACH)
         } else {
-            ((base[0] - 1).max(0), (base[0] + 1).min(d0 - 1))
+            ((base[0] - REACH).max(0), (base[0] + REACH).min(d0 - 1))
         };
-        let mut off = [-1isize; D];
+        let mut off = [-REACH; D];
         loop {
             let row = (1..D)
                 .rev()
@@ -359,10 +367,11 @@ impl<const D: usize> CellSearch<D> {
         base
     }
 
-    /// Calls `f` with the particles of each of the 3^D cells around the cell `base`, cell by
-    /// cell (axis 0 fastest; each cell once, also when a periodic axis has fewer than 3 cells).
+    /// Calls `f` with the particles of each of the (2 REACH + 1)^D cells around the cell
+    /// `base`, cell by cell (axis 0 fastest; each cell once, also when a periodic axis has
+    /// fewer than 2 REACH + 1 cells).
     fn visit_cells(&self, base: &[isize; D], mut f: impl FnMut(&[u32])) {
-        let mut off = [-1isize; D];
+        let mut off = [-REACH; D];
         loop {
             let id = (0..D)
                 .rev()
@@ -378,14 +387,14 @@ impl<const D: usize> CellSearch<D> {
     }
 
     /// Index on axis `k` of the cell `base + off` (wrapped on a periodic axis), or `None`
-    /// outside the grid, or where a periodic axis has fewer than 3 cells and the offset
-    /// would revisit a cell.
+    /// outside the grid, or where a periodic axis has fewer than 2 REACH + 1 cells and the
+    /// offset would revisit a cell (only the first `dk` offsets, −REACH upward, are kept).
     #[inline(always)]
     fn axis_cell(&self, k: usize, base: isize, off: isize) -> Option<usize> {
         let dk = self.dims[k] as isize;
         let i = base + off;
         if self.domain.periodic[k].is_some() {
-            if dk < 3 && off != 0 && (dk == 1 || off == 1) {
+            if off >= dk - REACH {
                 return None;
             }
             Some(i.rem_euclid(dk) as usize)
@@ -409,16 +418,16 @@ fn copy_chunks(chunks: &[Vec<u32>], dst: &mut [u32]) {
     }
 }
 
-/// Advances the cell offsets `off[from..]` through {−1, 0, 1}^(D−from), axis `from`
+/// Advances the cell offsets `off[from..]` through {−REACH, …, REACH}^(D−from), axis `from`
 /// fastest (an odometer); false once every combination was visited.
 #[inline(always)]
 fn next_offset<const D: usize>(off: &mut [isize; D], from: usize) -> bool {
     for o in &mut off[from..] {
         *o += 1;
-        if *o <= 1 {
+        if *o <= REACH {
             return true;
         }
-        *o = -1;
+        *o = -REACH;
     }
     false
 }
@@ -469,8 +478,9 @@ mod tests {
         check::<2>(800, 0.09, per, 7);
         let per3 = Domain { periodic: [Some((0.0, 1.0)), None, Some((0.0, 1.0))] };
         check::<3>(500, 0.2, per3, 8);
-        // Fewer than three cells per period.
+        // Fewer than 2 REACH + 1 cells per period (4, and 2).
         check::<2>(200, 0.45, per, 9);
+        check::<2>(200, 0.9, per, 10);
     }
 
     /// The row ranges give each list in exactly the cell-by-cell order (so the sums over
