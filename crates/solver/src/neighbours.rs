@@ -281,8 +281,8 @@ impl<const D: usize> CellSearch<D> {
     /// with each row's length in `counts`; `disp` is the displacement of the domain (the
     /// plain difference when nothing is periodic, so the hot loop has no per-axis test).
     ///
-    /// Whether a candidate is within the radius is random from one to the next (about a
-    /// third are), so a branch per candidate mispredicts often: the candidates of a run are
+    /// Whether a candidate is within the radius is random from one to the next (about half
+    /// are in 2D), so a branch per candidate mispredicts often: the candidates of a run are
     /// tested in groups of 64 into a bit mask without branches, and the set bits are then
     /// read off in order (the same neighbours in the same order as a plain filter).
     #[inline(always)]
@@ -323,8 +323,8 @@ impl<const D: usize> CellSearch<D> {
     ///
     /// Axis 0 varies fastest in the cell id, so the (up to) 2 REACH + 1 cells of one row
     /// around `p` are consecutive ids and their particles one contiguous run of `sorted`:
-    /// one range per row of cells ((2 REACH + 1)^(D−1) ranges) instead of one per cell. A row that wraps
-    /// around a periodic axis 0 is not contiguous and goes cell by cell.
+    /// one range per row of cells ((2 REACH + 1)^(D−1) ranges) instead of one per cell.
+    /// A row that wraps around a periodic axis 0 is not contiguous and goes cell by cell.
     #[inline]
     fn visit_candidates(&self, p: &SVector<f64, D>, mut f: impl FnMut(&[u32])) {
         let base = self.cell_index(p);
