@@ -14,7 +14,7 @@ pub fn drop_scene(edit: impl FnOnce(&mut serde_json::Value)) -> Scene {
 }
 
 /// The `poiseuille_periodic` case file (CASES.md): its `scene` is the quick tier's channel.
-pub const PERIODIC_CHANNEL_CASE: &str = include_str!("../../../../validation/poiseuille_periodic.json");
+const PERIODIC_CHANNEL_CASE: &str = include_str!("../../../../validation/poiseuille_periodic.json");
 
 /// The periodic channel scene of `validation/poiseuille_periodic.json` (Re = 40, D/36) with
 /// `edit` applied to its JSON value.
