@@ -401,8 +401,7 @@ mod tests {
                         a.push(c, v);
                     }
                 }
-                a.row_ptr.push(a.vals.len());
-                a.inv_diag.push(0.25);
+                a.end_row();
             }
         }
         a
@@ -481,6 +480,7 @@ mod tests {
     fn a_singular_operator_is_a_typed_breakdown() {
         let mut a = operator(10, 0.0);
         a.vals.iter_mut().for_each(|v| *v = 0.0);
+        a.diag.iter_mut().for_each(|v| *v = 0.0);
         let b = vec![1.0; a.n()];
         let params = KrylovParams { tolerance: 1e-8, max_iterations: 50 };
         for solver in [cg as Solver, bi as Solver] {

@@ -3,9 +3,9 @@
 //! `A = −L` is the Shao–Lo Laplacian (Qiu 2013 eq. 12, NUMERICS.md "Signs and the PPE
 //! matrix") restricted to the particles that are not free-surface particles (their p = 0
 //! is a Dirichlet condition, so their columns drop out). Rows are assembled in parallel
-//! straight into compressed sparse rows from the neighbour lists, in the fixed neighbour
-//! order: the pattern is known, so the sort that a triplet assembly performs is not needed
-//! per step. [`PpeMatrix::to_triplets`] gives the triplet form for the direct solver and
+//! straight into compressed sparse rows (the diagonal apart, the off-diagonals in `f32`:
+//! see [`PpeMatrix`]) from the neighbour lists, in the fixed neighbour order: the pattern
+//! is known, so the sort that a triplet assembly performs is not needed per step. [`PpeMatrix::to_triplets`] gives the triplet form for the direct solver and
 //! for tests that check the fast assembly against faer's triplet assembly.
 //!
 //! The Krylov solvers (Jacobi-preconditioned CG and BiCGSTAB) are [`crate::krylov`]'s,
@@ -23,18 +23,33 @@ use faer::sparse::linalg::solvers::Lu;
 use faer::sparse::{SparseColMat, Triplet};
 use rayon::prelude::*;
 
-/// Sparse PPE matrix in compressed sparse rows, with its inverse diagonal (Jacobi).
+/// Sparse PPE matrix: the diagonal in `f64`, the off-diagonal entries in compressed sparse
+/// rows with `f32` values, and the inverse diagonal (Jacobi).
+///
+/// Why `f32` off-diagonals: the matrix products are bound by memory traffic once the
+/// matrix outgrows the cache (the drop at Δx = 0.005, 125 676 rows of ~28 entries: 43 MB
+/// at 12 bytes per entry against a 32 MB L3); at 8 bytes per entry one BiCGSTAB iteration
+/// there took 3.77 instead of 4.43 ms (2 threads, tuned preset, alternating runs), and
+/// 0.174 instead of 0.196 ms at Δx = 0.02 (7860 rows), with the same iterations. The assemblies
+/// round each pair coefficient to `f32` *before* using it, for the off-diagonal entry and
+/// in the diagonal sum alike, so the stored matrix is exactly a Laplacian whose pair
+/// coefficients moved by ≤ 6e-8 relative (far below the discretisation error), its rows
+/// still sum to zero where the Laplacian's do, and it is still symmetric where the
+/// Laplacian is (the constant null space of a closed domain is kept). The products are
+/// summed in `f64`.
 #[derive(Debug, Clone, Default)]
 pub struct PpeMatrix {
-    /// Row offsets (length n + 1).
+    /// Diagonal entries (length n), in units of `(1/ρ) ∇²` \[m/kg\].
+    pub diag: Vec<f64>,
+    /// Offsets of each row's off-diagonal entries (length n + 1).
     pub row_ptr: Vec<usize>,
-    /// Column of each entry, row by row.
+    /// Column of each off-diagonal entry, row by row (a column may repeat: a wall mirror
+    /// shares its source's unknown).
     pub cols: Vec<u32>,
-    /// Value of each entry, row by row (the diagonal first), in units of `(1/ρ) ∇²`
-    /// \[m/kg\]. Columns and values are separate arrays: the product streams 12 bytes per
-    /// entry instead of the 16 of a padded `(u32, f64)` pair (it is bound by memory
-    /// traffic; measured in the commit that split them).
-    pub vals: Vec<f64>,
+    /// Value of each off-diagonal entry, row by row. Columns and values are separate
+    /// arrays: the product streams 8 bytes per entry instead of the 16 of a padded
+    /// `(u32, f64)` pair.
+    pub vals: Vec<f32>,
     /// 1 / A_ii.
     pub inv_diag: Vec<f64>,
 }
@@ -42,7 +57,7 @@ pub struct PpeMatrix {
 impl PpeMatrix {
     /// Number of unknowns.
     pub fn n(&self) -> usize {
-        self.inv_diag.len()
+        self.diag.len()
     }
 
     /// y = A x (row-parallel, deterministic).
@@ -50,9 +65,10 @@ impl PpeMatrix {
         y.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, yi)| *yi = self.row_dot(i, x));
     }
 
-    /// (A x)_i: the row's entries in their stored order dealt round-robin to four partial
-    /// sums, added as (s₀ + s₁) + (s₂ + s₃) (a fixed order: the result does not depend on
-    /// the thread count).
+    /// (A x)_i: the diagonal term and the row's off-diagonal entries in their stored order
+    /// dealt round-robin to four partial sums (the diagonal term starts the first), added
+    /// as (s₀ + s₁) + (s₂ + s₃) (a fixed order: the result does not depend on the thread
+    /// count).
     ///
     /// One running sum chains every addition to the previous one (its latency, not the
     /// loads, then sets the pace); four independent sums overlap them. Measured on the drop
@@ -61,48 +77,86 @@ impl PpeMatrix {
     pub fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
         let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
         let (cols, vals) = (&self.cols[s..e], &self.vals[s..e]);
-        let mut acc = [0.0; 4];
+        let mut acc = [self.diag[i] * x[i], 0.0, 0.0, 0.0];
         let (cq, cr) = cols.as_chunks::<4>();
         let (vq, vr) = vals.as_chunks::<4>();
         for (c, v) in cq.iter().zip(vq) {
             for k in 0..4 {
-                acc[k] += v[k] * x[c[k] as usize];
+                acc[k] += f64::from(v[k]) * x[c[k] as usize];
             }
         }
         for (k, (&c, &v)) in cr.iter().zip(vr).enumerate() {
-            acc[k] += v * x[c as usize];
+            acc[k] += f64::from(v) * x[c as usize];
         }
         (acc[0] + acc[1]) + (acc[2] + acc[3])
     }
 
-    /// Sizes the entry arrays for the row offsets already in `row_ptr`.
+    /// Sizes the off-diagonal arrays for the row offsets already in `row_ptr`, and the
+    /// diagonals for its rows.
     pub fn resize_entries(&mut self) {
         let nnz = self.row_ptr.last().copied().unwrap_or(0);
         self.cols.resize(nnz, 0);
         self.vals.resize(nnz, 0.0);
+        let n = self.row_ptr.len().saturating_sub(1);
+        self.diag.resize(n, 0.0);
+        self.inv_diag.resize(n, 0.0);
     }
 
-    /// The (column, value) entries of row `i`.
+    /// Sets `inv_diag` from `diag`.
+    pub fn invert_diagonal(&mut self) {
+        self.inv_diag.resize(self.diag.len(), 0.0);
+        self.inv_diag.par_iter_mut().zip(&self.diag).with_min_len(512).for_each(|(d, a)| *d = 1.0 / a);
+    }
+
+    /// The (column, value) entries of row `i`: the diagonal first, then the off-diagonals.
     pub fn row(&self, i: usize) -> impl Iterator<Item = (u32, f64)> + '_ {
         let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);
-        self.cols[s..e].iter().copied().zip(self.vals[s..e].iter().copied())
+        let off = self.cols[s..e].iter().copied().zip(self.vals[s..e].iter().map(|&v| f64::from(v)));
+        std::iter::once((i as u32, self.diag[i])).chain(off)
     }
 
-    /// Appends an entry to the last row (building a matrix row by row; push the row's end
-    /// to `row_ptr` after its entries).
+    /// Appends an entry to the row being built (building a matrix row by row from
+    /// `row_ptr = [0]`; call [`PpeMatrix::end_row`] after each row's entries). An entry in
+    /// the diagonal column is added to the diagonal; an off-diagonal value is stored as
+    /// `f32`.
     pub fn push(&mut self, col: usize, val: f64) {
-        self.cols.push(col as u32);
-        self.vals.push(val);
+        let row = self.row_ptr.len() - 1;
+        if self.diag.len() == row {
+            self.diag.push(0.0);
+        }
+        if col == row {
+            self.diag[row] += val;
+        } else {
+            self.cols.push(col as u32);
+            self.vals.push(val as f32);
+        }
+    }
+
+    /// Ends the row being built (see [`PpeMatrix::push`]) and sets its inverse diagonal.
+    pub fn end_row(&mut self) {
+        let row = self.row_ptr.len() - 1;
+        if self.diag.len() == row {
+            self.diag.push(0.0);
+        }
+        self.row_ptr.push(self.vals.len());
+        self.inv_diag.push(1.0 / self.diag[row]);
     }
 
     /// The matrix as triplets (row, column, value).
     pub fn to_triplets(&self) -> Vec<Triplet<usize, usize, f64>> {
-        let mut t = Vec::with_capacity(self.vals.len());
+        let mut t = Vec::with_capacity(self.vals.len() + self.n());
         for i in 0..self.n() {
             t.extend(self.row(i).map(|(c, v)| Triplet::new(i, c as usize, v)));
         }
         t
     }
+}
+
+/// A pair coefficient rounded to the `f32` the matrix stores (see [`PpeMatrix`]): the
+/// assemblies use the rounded value both off the diagonal and in the diagonal sum.
+#[inline]
+pub fn stored(c: f64) -> f64 {
+    f64::from(c as f32)
 }
 
 /// faer's sparse LU of `m`, with faer's global parallelism set to sequential first.
@@ -330,8 +384,7 @@ mod tests {
                 if i + 1 < rows {
                     push(k + m, -1.0);
                 }
-                a.row_ptr.push(a.vals.len());
-                a.inv_diag.push(0.25);
+                a.end_row();
             }
         }
         a
@@ -419,8 +472,7 @@ mod tests {
             for (c, v) in [((i + n - 1) % n, -1.0), (i, 2.0), ((i + 1) % n, -1.0)] {
                 a.push(c, v);
             }
-            a.row_ptr.push(a.vals.len());
-            a.inv_diag.push(0.5);
+            a.end_row();
         }
         let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.3).sin() + 0.7).collect();
         for solver in [PpeSolver::Cg, PpeSolver::Bicgstab, PpeSolver::Direct] {

@@ -50,37 +50,40 @@ pub fn par_rows_mut<T: Send, F: Fn(usize, &mut [T]) + Sync>(offsets: &[usize], d
     }
 }
 
-/// [`par_rows_mut`] over two arrays with the same row layout (the columns and the values of
-/// a compressed sparse row matrix): `f(a, &mut xs[row a], &mut ys[row a])`.
-pub fn par_rows_mut2<X: Send, Y: Send, F: Fn(usize, &mut [X], &mut [Y]) + Sync>(
+/// [`par_rows_mut`] over the rows of a compressed sparse row matrix with a separate
+/// diagonal: `f(a, &mut cols[row a], &mut vals[row a], &mut diag[a])`.
+pub fn par_csr_rows_mut<X: Send, Y: Send, Z: Send, F: Fn(usize, &mut [X], &mut [Y], &mut Z) + Sync>(
     offsets: &[usize],
-    xs: &mut [X],
-    ys: &mut [Y],
+    cols: &mut [X],
+    vals: &mut [Y],
+    diag: &mut [Z],
     f: &F,
 ) {
-    fn rec<X: Send, Y: Send, F: Fn(usize, &mut [X], &mut [Y]) + Sync>(
+    fn rec<X: Send, Y: Send, Z: Send, F: Fn(usize, &mut [X], &mut [Y], &mut Z) + Sync>(
         lo: usize,
         hi: usize,
         offsets: &[usize],
         xs: &mut [X],
         ys: &mut [Y],
+        zs: &mut [Z],
         f: &F,
     ) {
         if hi - lo <= 256 {
             let base = offsets[lo];
-            for a in lo..hi {
+            for (a, z) in (lo..hi).zip(zs) {
                 let (s, e) = (offsets[a] - base, offsets[a + 1] - base);
-                f(a, &mut xs[s..e], &mut ys[s..e]);
+                f(a, &mut xs[s..e], &mut ys[s..e], z);
             }
         } else {
             let mid = lo + (hi - lo) / 2;
             let (xl, xr) = xs.split_at_mut(offsets[mid] - offsets[lo]);
             let (yl, yr) = ys.split_at_mut(offsets[mid] - offsets[lo]);
-            rayon::join(|| rec(lo, mid, offsets, xl, yl, f), || rec(mid, hi, offsets, xr, yr, f));
+            let (zl, zr) = zs.split_at_mut(mid - lo);
+            rayon::join(|| rec(lo, mid, offsets, xl, yl, zl, f), || rec(mid, hi, offsets, xr, yr, zr, f));
         }
     }
     let n = offsets.len().saturating_sub(1);
     if n > 0 {
-        rec(0, n, offsets, xs, ys, f);
+        rec(0, n, offsets, cols, vals, &mut diag[..n], f);
     }
 }

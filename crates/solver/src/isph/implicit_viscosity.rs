@@ -13,9 +13,9 @@
 //! from `uⁿ`) is known and moves to the right-hand side.
 
 use crate::error::Cause;
-use crate::ppe::{PpeMatrix, PpeSolve};
+use crate::ppe::{PpeMatrix, PpeSolve, stored};
 use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
-use crate::stage::{Stage, StepContext, par_rows_mut2};
+use crate::stage::{Stage, StepContext, par_csr_rows_mut};
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -76,7 +76,7 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
         m.row_ptr.resize(n + 1, 0);
         m.row_ptr[0] = 0;
         m.row_ptr[1..].par_iter_mut().enumerate().with_min_len(256).for_each(|(a, len)| {
-            *len = 1 + list
+            *len = list
                 .of(a)
                 .iter()
                 .filter(|&&b| column(b as usize).is_some_and(|(col, _)| col as usize != a))
@@ -86,32 +86,27 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
             m.row_ptr[a + 1] += m.row_ptr[a];
         }
         m.resize_entries();
-        par_rows_mut2(&m.row_ptr, &mut m.cols, &mut m.vals, &|a, cols: &mut [u32], vals: &mut [f64]| {
+        let row = |a, cols: &mut [u32], vals: &mut [f32], diag: &mut f64| {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
-            let mut diag = 1.0;
-            let mut k = 1;
+            *diag = 1.0;
+            let mut k = 0;
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                // −Δt ν L: w = −c (r·∇W)/(r² + η²) ≥ 0 per pair, (u_a − u_b) w.
-                let w = -c * p.f * p.r2 / (p.r2 + eta2);
-                diag += w;
+                // −Δt ν L: w = −c (r·∇W)/(r² + η²) ≥ 0 per pair, (u_a − u_b) w; rounded as
+                // stored, here and in the diagonal (see `PpeMatrix`).
+                let w = stored(-c * p.f * p.r2 / (p.r2 + eta2));
+                *diag += w;
                 match column(b as usize) {
-                    Some((col, f)) if col as usize == a => diag -= w * f,
+                    Some((col, f)) if col as usize == a => *diag -= w * f,
                     Some((col, f)) => {
-                        (cols[k], vals[k]) = (col, -w * f);
+                        (cols[k], vals[k]) = (col, (-w * f) as f32);
                         k += 1;
                     }
                     None => {}
                 }
             }
-            (cols[0], vals[0]) = (a as u32, diag);
-        });
-        m.inv_diag.resize(n, 0.0);
-        let (vals, row_ptr) = (&m.vals, &m.row_ptr);
-        m.inv_diag
-            .par_iter_mut()
-            .enumerate()
-            .with_min_len(512)
-            .for_each(|(a, d)| *d = 1.0 / vals[row_ptr[a]]);
+        };
+        par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut m.diag, &row);
+        m.invert_diagonal();
         let (u_old, u) = (&s.u_old, &mut s.particles.u);
         for k in 0..D {
             self.rhs.resize(n, 0.0);

@@ -2,9 +2,9 @@
 //! velocity correction, position update.
 
 use crate::error::Cause;
-use crate::ppe::PpeSolve;
+use crate::ppe::{PpeSolve, stored};
 use crate::scene::{Divergence, PressureGradient};
-use crate::stage::{Stage, StepContext, par_rows_mut2};
+use crate::stage::{Stage, StepContext, par_csr_rows_mut};
 use crate::state::{State, Vector};
 use nalgebra::SMatrix;
 use rayon::prelude::*;
@@ -76,14 +76,14 @@ impl<const D: usize> Stage<D> for PpeAssemble {
         let known_boundary = s.particles.total() > n + linked + s.mirrors.source.len();
         sys.singular = rows == n && !known_boundary;
         let (list, row_of, particle_of) = (&s.neighbours, &sys.row_of, &sys.particle_of);
-        // Row lengths: the diagonal plus the interior neighbours.
+        // Row lengths: the interior neighbours (the diagonal is stored apart).
         let m = &mut sys.matrix;
         m.row_ptr.resize(rows + 1, 0);
         m.row_ptr[0] = 0;
         m.row_ptr[1..].par_iter_mut().enumerate().with_min_len(256).for_each(|(i, len)| {
             let a = particle_of[i] as usize;
             let own = i as u32;
-            *len = 1 + list
+            *len = list
                 .of(a)
                 .iter()
                 .filter(|&&b| {
@@ -96,33 +96,30 @@ impl<const D: usize> Stage<D> for PpeAssemble {
             m.row_ptr[i + 1] += m.row_ptr[i];
         }
         m.resize_entries();
-        m.inv_diag.resize(rows, 0.0);
         let (v, rho, eta2) = (s.volume, s.density, 0.01 * s.h * s.h);
         let pairs = &s.pairs;
-        par_rows_mut2(&m.row_ptr, &mut m.cols, &mut m.vals, &|i, cols: &mut [u32], vals: &mut [f64]| {
+        let row = |i, cols: &mut [u32], vals: &mut [f32], diag: &mut f64| {
             let a = particle_of[i] as usize;
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
-            let mut diag = 0.0;
-            let mut k = 1;
+            *diag = 0.0;
+            let mut k = 0;
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                 let rb = row_of[b as usize];
                 if rb == i as u32 {
                     // The particle's own mirror: c (p_a − p_a) = 0.
                     continue;
                 }
-                let c = -2.0 * v * p.f * p.r2 / (rho * (p.r2 + eta2));
-                diag += c;
+                // Rounded as stored, here and in the diagonal (see `PpeMatrix`).
+                let c = stored(-2.0 * v * p.f * p.r2 / (rho * (p.r2 + eta2)));
+                *diag += c;
                 if rb != u32::MAX {
-                    (cols[k], vals[k]) = (rb, -c);
+                    (cols[k], vals[k]) = (rb, -c as f32);
                     k += 1;
                 }
             }
-            (cols[0], vals[0]) = (i as u32, diag);
-        });
-        let (vals, row_ptr) = (&m.vals, &m.row_ptr);
-        m.inv_diag.par_iter_mut().enumerate().with_min_len(512).for_each(|(i, d)| {
-            *d = 1.0 / vals[row_ptr[i]];
-        });
+        };
+        par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut m.diag, &row);
+        m.invert_diagonal();
         sys.rhs.resize(rows, 0.0);
         let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
         self.dt_max = self.dt_max.max(ctx.dt);
