@@ -5,8 +5,9 @@
 //! is a Dirichlet condition, so their columns drop out). Rows are assembled in parallel
 //! straight into compressed sparse rows (the diagonal apart, the off-diagonals in `f32`:
 //! see [`PpeMatrix`]) from the neighbour lists, in the fixed neighbour order: the pattern
-//! is known, so the sort that a triplet assembly performs is not needed per step. [`PpeMatrix::to_triplets`] gives the triplet form for the direct solver and
-//! for tests that check the fast assembly against faer's triplet assembly.
+//! is known, so the sort that a triplet assembly performs is not needed per step.
+//! [`PpeMatrix::to_triplets`] gives the triplet form for the direct solver and for tests
+//! that check the fast assembly against faer's triplet assembly.
 //!
 //! The Krylov solvers (Jacobi-preconditioned CG and BiCGSTAB) are [`crate::krylov`]'s,
 //! whose parallel vector operations give the same bits for any thread count; the direct
@@ -30,9 +31,9 @@ use rayon::prelude::*;
 /// matrix outgrows the cache (the drop at Δx = 0.005, 125 676 rows of ~28 entries: 43 MB
 /// at 12 bytes per entry against a 32 MB L3); at 8 bytes per entry one BiCGSTAB iteration
 /// there took 3.77 instead of 4.43 ms (2 threads, tuned preset, alternating runs), and
-/// 0.174 instead of 0.196 ms at Δx = 0.02 (7860 rows), with the same iterations. The assemblies
-/// round each pair coefficient to `f32` *before* using it, for the off-diagonal entry and
-/// in the diagonal sum alike, so the stored matrix is exactly a Laplacian whose pair
+/// 0.174 instead of 0.196 ms at Δx = 0.02 (7860 rows), with the same iterations. The
+/// assemblies round each pair coefficient to `f32` *before* using it, for the off-diagonal
+/// entry and in the diagonal sum alike, so the stored matrix is exactly a Laplacian whose pair
 /// coefficients moved by ≤ 6e-8 relative (far below the discretisation error), its rows
 /// still sum to zero where the Laplacian's do, and it is still symmetric where the
 /// Laplacian is (the constant null space of a closed domain is kept). The products are
@@ -97,9 +98,7 @@ impl PpeMatrix {
         let nnz = self.row_ptr.last().copied().unwrap_or(0);
         self.cols.resize(nnz, 0);
         self.vals.resize(nnz, 0.0);
-        let n = self.row_ptr.len().saturating_sub(1);
-        self.diag.resize(n, 0.0);
-        self.inv_diag.resize(n, 0.0);
+        self.diag.resize(self.row_ptr.len().saturating_sub(1), 0.0);
     }
 
     /// Sets `inv_diag` from `diag`.
@@ -120,10 +119,7 @@ impl PpeMatrix {
     /// the diagonal column is added to the diagonal; an off-diagonal value is stored as
     /// `f32`.
     pub fn push(&mut self, col: usize, val: f64) {
-        let row = self.row_ptr.len() - 1;
-        if self.diag.len() == row {
-            self.diag.push(0.0);
-        }
+        let row = self.open_row();
         if col == row {
             self.diag[row] += val;
         } else {
@@ -134,12 +130,18 @@ impl PpeMatrix {
 
     /// Ends the row being built (see [`PpeMatrix::push`]) and sets its inverse diagonal.
     pub fn end_row(&mut self) {
+        let row = self.open_row();
+        self.row_ptr.push(self.vals.len());
+        self.inv_diag.push(1.0 / self.diag[row]);
+    }
+
+    /// The index of the row being built, its diagonal allocated.
+    fn open_row(&mut self) -> usize {
         let row = self.row_ptr.len() - 1;
         if self.diag.len() == row {
             self.diag.push(0.0);
         }
-        self.row_ptr.push(self.vals.len());
-        self.inv_diag.push(1.0 / self.diag[row]);
+        row
     }
 
     /// The matrix as triplets (row, column, value).
