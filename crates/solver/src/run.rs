@@ -315,6 +315,7 @@ impl<const D: usize> Simulation<D> {
             pairs: Vec::new(),
             div_r: vec![0.0; n],
             free_surface: vec![false; n],
+            particle_density: Vec::new(),
             volume: scene.dx.powi(D as i32),
             density: scene.fluid.density,
             dx: scene.dx,

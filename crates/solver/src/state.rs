@@ -77,6 +77,9 @@ pub struct State<const D: usize> {
     pub div_r: Vec<f64>,
     /// Free-surface flags (`div r` below the threshold): p = 0 there.
     pub free_surface: Vec<bool>,
+    /// ρ/ρ₀ by kernel summation (`isph::particle_density`), computed each step before the
+    /// PPE assembly that reads it; empty unless the density relaxation is on.
+    pub particle_density: Vec<f64>,
     /// Particle volume V = Δx^D \[m^D\] (equal for all particles).
     pub volume: f64,
     /// Density ρ \[kg/m³\].

@@ -6,7 +6,8 @@
 //! `inlet_sources` (inflow only) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
 //! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) or `surface_pressure`
 //! (σ > 0, `young_laplace`: p = σκ on the free surface) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
-//! `mirror_velocity` | `dummy_velocity` (walls only) → `ppe_assemble`
+//! `mirror_velocity` | `dummy_velocity` (walls only) → `particle_density` (density
+//! relaxation only) → `ppe_assemble`
 //! (eqs. 10, 12) → `ppe_solve` (eq. 5) → `dummy_pressure` (dummy walls only) →
 //! `correction` (eqs. 6, 15) → `position` (eq. 7) →
 //! `shifting` (eqs. 20–21; when configured) → `open_boundaries` (inflow/outflow only:
@@ -14,6 +15,7 @@
 
 pub mod consistent_viscosity;
 pub mod implicit_viscosity;
+pub mod particle_density;
 pub mod predictor;
 pub mod projection;
 pub mod shifting;
@@ -33,29 +35,6 @@ use crate::state::Vector;
 
 /// Particles are reordered by cell every this many steps.
 const REORDER_EVERY: usize = 25;
-
-/// `div r = −Σ_b V r_ab·∇_aW_ab` (Qiu eq. 16) at a point of the cell-centred lattice of
-/// spacing `V^(1/D)` with every lattice point within the support as a neighbour.
-fn lattice_div_r<K: Kernel, const D: usize>(kernel: &Scaled<K, D>, volume: f64) -> f64 {
-    let dx = volume.powf(1.0 / D as f64);
-    let n = (kernel.support / dx).ceil() as i64;
-    let mut idx = [-n; D];
-    let mut sum = 0.0;
-    'all: loop {
-        let r2 = idx.iter().map(|&i| (i as f64 * dx).powi(2)).sum::<f64>();
-        if r2 > 0.0 {
-            sum -= volume * kernel.grad_factor(r2.sqrt()) * r2;
-        }
-        for i in idx.iter_mut() {
-            if *i < n {
-                *i += 1;
-                continue 'all;
-            }
-            *i = -n;
-        }
-        return sum;
-    }
-}
 
 /// Builds the ISPH stage list for `scene` (`open`: its inflow/outflow, when it has them).
 pub fn build_stages<K: Kernel, const D: usize>(
@@ -120,8 +99,10 @@ pub fn build_stages<K: Kernel, const D: usize>(
         Some(WallModel::Dummy) => stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Velocity))),
         None => {}
     }
-    let relaxation = (opts.density_relaxation > 0.0)
-        .then(|| (opts.density_relaxation, lattice_div_r(&kernel, scene.dx.powi(D as i32))));
+    let relaxation = (opts.density_relaxation > 0.0).then_some(opts.density_relaxation);
+    if relaxation.is_some() {
+        stages.push(Box::new(particle_density::ParticleDensity::new(kernel, scene.dx)));
+    }
     stages.push(Box::new(projection::PpeAssemble {
         divergence: opts.divergence,
         relaxation,

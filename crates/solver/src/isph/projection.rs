@@ -17,9 +17,8 @@ use rayon::prelude::*;
 /// Density relaxation (`scheme.isph.density_relaxation` = α > 0): the source gets the
 /// density-invariant term of Shao & Lo 2003 (eq. 18, `∇·(∇p/ρ) = (ρ₀ − ρ*)/(ρ₀ Δt²)`)
 /// weighted by α, as in the stabilised ISPH of Asai, Aly, Sonoda & Sakai 2012 (J. Appl.
-/// Math. 2012:139583): `b_a += α (ρ_a/ρ₀ − 1)/(Δt Δt_max)`, with the particle density
-/// measured by `ρ_a/ρ₀ = div r_a / div r₀` (`div r` of the free-surface stage grows with
-/// the number of particles per volume; `div r₀` is its value on the initial lattice).
+/// Math. 2012:139583): `b_a += α (ρ_a/ρ₀ − 1)/(Δt Δt_max)`, with ρ_a/ρ₀ the kernel sum of
+/// the `particle_density` stage (`isph::particle_density`).
 /// `Δt_max` is the largest step taken so far instead of a second `Δt`: the term corrects a
 /// fraction ~α of the density error per typical step, and a short step (one landing on a
 /// probe time) then corrects proportionally less. With `Δt²` a landing step 100 times
@@ -29,8 +28,8 @@ use rayon::prelude::*;
 pub struct PpeAssemble {
     /// Divergence operator of the source term.
     pub divergence: Divergence,
-    /// `(α, div r₀)` of the density relaxation, when on.
-    pub relaxation: Option<(f64, f64)>,
+    /// α of the density relaxation, when on (it reads `State::particle_density`).
+    pub relaxation: Option<f64>,
     /// Largest Δt so far \[s\] (density relaxation).
     pub dt_max: f64,
     /// The free-surface particles carry known, non-zero pressures (the Young–Laplace
@@ -123,7 +122,8 @@ impl<const D: usize> Stage<D> for PpeAssemble {
         sys.rhs.resize(rows, 0.0);
         let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
         self.dt_max = self.dt_max.max(ctx.dt);
-        let (p, div_r, relaxation, dt_max) = (&s.particles.p, &s.div_r, self.relaxation, self.dt_max);
+        let (p, density, relaxation, dt_max) =
+            (&s.particles.p, &s.particle_density, self.relaxation, self.dt_max);
         let surface_pressure = self.surface_pressure;
         sys.rhs.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
             let a = particle_of[i] as usize;
@@ -159,7 +159,7 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                 }
             }
             let relax = match relaxation {
-                Some((alpha, div_r0)) => alpha * (div_r[a] / div_r0 - 1.0) * inv_dt / dt_max,
+                Some(alpha) => alpha * (density[a] - 1.0) * inv_dt / dt_max,
                 None => 0.0,
             };
             *r = -div * inv_dt + known + relax;
