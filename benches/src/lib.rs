@@ -20,7 +20,7 @@
 
 use meniscus::Scene;
 use meniscus::profile::{Snapshot, Stepper, on_worker};
-use meniscus::scene::{PpeSolver, Scheme, Shifting};
+use meniscus::scene::{PpeSolver, Preconditioner, Scheme, Shifting};
 use meniscus::stage::StepContext;
 use std::time::{Duration, Instant};
 
@@ -86,12 +86,14 @@ pub fn with_implicit_viscosity(scene: &Scene) -> Scene {
     s
 }
 
-/// `scene` with its PPE solved by `solver` (Krylov tolerance 1e-3, the paper's).
-pub fn with_ppe_solver(scene: &Scene, solver: PpeSolver) -> Scene {
+/// `scene` with its PPE solved by `solver` with `preconditioner` (Krylov tolerance 1e-3,
+/// the paper's).
+pub fn with_ppe_solver(scene: &Scene, solver: PpeSolver, preconditioner: Preconditioner) -> Scene {
     let mut s = scene.clone();
     let Scheme::Isph(opts) = &mut s.scheme else { return s };
     opts.ppe.solver = solver;
     opts.ppe.tolerance = 1e-3;
+    opts.ppe.preconditioner = preconditioner;
     s
 }
 
@@ -267,7 +269,7 @@ mod tests {
         for b in &s {
             meniscus::scene::validate(&b.scene).unwrap();
         }
-        let direct = with_ppe_solver(&s[0].scene, PpeSolver::Direct);
+        let direct = with_ppe_solver(&s[0].scene, PpeSolver::Direct, Preconditioner::Jacobi);
         let Scheme::Isph(o) = &direct.scheme else { panic!("an ISPH scene") };
         assert_eq!(o.ppe.solver, PpeSolver::Direct);
     }

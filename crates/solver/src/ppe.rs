@@ -17,7 +17,7 @@
 use crate::error::Cause;
 use crate::krylov::{self, KrylovError, KrylovParams, Preconditioner, Workspace};
 use crate::scene::{PpeOptions, PpeSolver, Preconditioner as PreconditionerKind};
-use crate::two_level::TwoLevel;
+use crate::two_level::CoarseSpace;
 use faer::Mat;
 use faer::sparse::linalg::LuError;
 use faer::sparse::linalg::solvers::Lu;
@@ -209,13 +209,21 @@ pub struct PpeSolve {
     b: Vec<f64>,
     r: Vec<f64>,
     workspace: Workspace,
+    coarse: CoarseSpace,
 }
 
 impl PpeSolve {
     /// A solver configured by the scene's `scheme.isph.ppe` options, measuring the
     /// residual.
     pub fn new(opts: PpeOptions) -> Self {
-        Self { opts, measure_residual: true, b: Vec::new(), r: Vec::new(), workspace: Workspace::default() }
+        Self {
+            opts,
+            measure_residual: true,
+            b: Vec::new(),
+            r: Vec::new(),
+            workspace: Workspace::default(),
+            coarse: CoarseSpace::new(opts.coarse_refresh),
+        }
     }
 
     /// Whether to measure the true residual after each solve: one more matrix product and
@@ -235,17 +243,38 @@ impl PpeSolve {
         }
     }
 
-    /// Solves `A p = b`; `p` holds the warm start on entry and the solution on exit.
-    ///
-    /// `singular` marks a system with no Dirichlet row (closed or periodic domain): `A`
-    /// then has the constant vector as null space, so `b` is projected onto mean zero and
-    /// the returned `p` has mean zero (NUMERICS.md).
+    /// Whether the solver keeps a coarse space across solves (the two-level
+    /// preconditioner), which [`PpeSolve::solve_keyed`] maps to the rows by their keys.
+    pub fn uses_row_keys(&self) -> bool {
+        self.opts.preconditioner == PreconditionerKind::TwoLevel && self.opts.solver != PpeSolver::Direct
+    }
+
+    /// Solves `A p = b`; `p` holds the warm start on entry and the solution on exit. With
+    /// no row keys, a two-level preconditioner is rebuilt for this solve.
     pub fn solve(
         &mut self,
         a: &PpeMatrix,
         b: &[f64],
         p: &mut [f64],
         singular: bool,
+    ) -> Result<PpeInfo, Cause> {
+        self.solve_keyed(a, b, p, singular, None)
+    }
+
+    /// [`PpeSolve::solve`] with a stable key per row (a particle id, unique among the
+    /// rows), so that the two-level preconditioner's coarse space follows the particles
+    /// from solve to solve and is rebuilt only every `coarse_refresh` solves.
+    ///
+    /// `singular` marks a system with no Dirichlet row (closed or periodic domain): `A`
+    /// then has the constant vector as null space, so `b` is projected onto mean zero and
+    /// the returned `p` has mean zero (NUMERICS.md).
+    pub fn solve_keyed(
+        &mut self,
+        a: &PpeMatrix,
+        b: &[f64],
+        p: &mut [f64],
+        singular: bool,
+        keys: Option<&[u32]>,
     ) -> Result<PpeInfo, Cause> {
         let n = a.n();
         if n == 0 {
@@ -266,8 +295,24 @@ impl PpeSolve {
             return Ok(PpeInfo { iterations: 0, residual: self.measure_residual.then_some(0.0) });
         }
         let iterations = match self.opts.solver {
-            PpeSolver::Cg => krylov_solve(&self.opts, a, b, p, true, singular, &mut self.workspace)?,
-            PpeSolver::Bicgstab => krylov_solve(&self.opts, a, b, p, false, singular, &mut self.workspace)?,
+            PpeSolver::Cg | PpeSolver::Bicgstab => {
+                let cg = self.opts.solver == PpeSolver::Cg;
+                let coarse = self.opts.preconditioner == PreconditionerKind::TwoLevel
+                    && self.coarse.prepare(a, keys, singular);
+                if coarse {
+                    krylov_with(
+                        &self.opts,
+                        a,
+                        &self.coarse.preconditioner(&a.inv_diag),
+                        b,
+                        p,
+                        cg,
+                        &mut self.workspace,
+                    )?
+                } else {
+                    krylov_with(&self.opts, a, &Jacobi(&a.inv_diag), b, p, cg, &mut self.workspace)?
+                }
+            }
             PpeSolver::Direct => {
                 direct(a, b, p, singular)?;
                 0
@@ -288,26 +333,7 @@ impl PpeSolve {
 }
 
 /// A Krylov solve of `A x = b` from the guess in `x` (CG if `cg`, else BiCGSTAB) with the
-/// configured preconditioner; returns the iterations.
-fn krylov_solve(
-    opts: &PpeOptions,
-    a: &PpeMatrix,
-    b: &[f64],
-    x: &mut [f64],
-    cg: bool,
-    singular: bool,
-    ws: &mut Workspace,
-) -> Result<usize, Cause> {
-    let two_level = match opts.preconditioner {
-        PreconditionerKind::TwoLevel if !singular => TwoLevel::new(a),
-        _ => None,
-    };
-    match two_level {
-        Some(m) => krylov_with(opts, a, &m, b, x, cg, ws),
-        None => krylov_with(opts, a, &Jacobi(&a.inv_diag), b, x, cg, ws),
-    }
-}
-
+/// preconditioner `m`; returns the iterations.
 fn krylov_with(
     opts: &PpeOptions,
     a: &PpeMatrix,
@@ -401,7 +427,13 @@ mod tests {
         let n = a.n();
         let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
         let solve = |preconditioner, solver| {
-            let opts = PpeOptions { solver, tolerance: 1e-10, max_iterations: 20_000, preconditioner };
+            let opts = PpeOptions {
+                solver,
+                tolerance: 1e-10,
+                max_iterations: 20_000,
+                preconditioner,
+                coarse_refresh: 1,
+            };
             let mut p = vec![0.0; n];
             let info = PpeSolve::new(opts).solve(&a, &b, &mut p, false).expect("converges");
             (p, info.iterations)
@@ -414,6 +446,115 @@ mod tests {
             assert!(err < 1e-7 * scale, "{solver:?}: {err} vs {scale}");
             assert!(2 * two < jacobi, "{solver:?}: two-level {two} iterations, Jacobi {jacobi}");
         }
+    }
+
+    /// The two-level solve of `a` (CG) with the given keys on solver `s`; returns the
+    /// iterations.
+    fn keyed_cg(
+        s: &mut PpeSolve,
+        a: &PpeMatrix,
+        b: &[f64],
+        keys: &[u32],
+        singular: bool,
+    ) -> (Vec<f64>, usize) {
+        let mut p = vec![0.0; a.n()];
+        let info = s.solve_keyed(a, b, &mut p, singular, Some(keys)).expect("converges");
+        (p, info.iterations)
+    }
+
+    fn two_level_cg(refresh: usize) -> PpeSolve {
+        PpeSolve::new(PpeOptions {
+            solver: PpeSolver::Cg,
+            tolerance: 1e-10,
+            max_iterations: 20_000,
+            preconditioner: PreconditionerKind::TwoLevel,
+            coarse_refresh: refresh,
+        })
+    }
+
+    /// The coarse space is kept between solves and follows the rows by their keys: a
+    /// renumbered system with its keys renumbered alike is solved with the same
+    /// preconditioner; rows whose keys it has never seen get Jacobi alone until the
+    /// rebuild that `coarse_refresh` schedules.
+    #[test]
+    fn coarse_space_follows_the_keys_and_is_rebuilt_on_schedule() {
+        let a = strip(200, 8);
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
+        let keys: Vec<u32> = (0..n as u32).collect();
+        let mut s = two_level_cg(3);
+        let (p0, fresh) = keyed_cg(&mut s, &a, &b, &keys, false);
+        // The same system renumbered (row k of `r` is row perm[k] of `a`).
+        let perm: Vec<usize> = (0..n).map(|k| (k * 37) % n).collect();
+        let mut inv = vec![0; n];
+        for (k, &i) in perm.iter().enumerate() {
+            inv[i] = k;
+        }
+        let mut r = PpeMatrix { row_ptr: vec![0], ..Default::default() };
+        for &i in &perm {
+            for (c, v) in a.row(i) {
+                r.push(inv[c as usize], v);
+            }
+            r.end_row();
+        }
+        let rb: Vec<f64> = perm.iter().map(|&i| b[i]).collect();
+        let rkeys: Vec<u32> = perm.iter().map(|&i| i as u32).collect();
+        let (pr, kept) = keyed_cg(&mut s, &r, &rb, &rkeys, false);
+        assert!(kept.abs_diff(fresh) <= 1, "renumbered: {kept} iterations against {fresh}");
+        let err = perm.iter().enumerate().map(|(k, &i)| (pr[k] - p0[i]).abs()).fold(0.0, f64::max);
+        let scale = p0.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        assert!(err < 1e-7 * scale, "{err} vs {scale}");
+        // Unknown keys: Jacobi alone until the third solve since the rebuild rebuilds.
+        let new_keys: Vec<u32> = (n as u32..2 * n as u32).collect();
+        let (_, jacobi) = keyed_cg(&mut s, &a, &b, &new_keys, false);
+        let (_, rebuilt) = keyed_cg(&mut s, &a, &b, &new_keys, false);
+        assert!(jacobi > 2 * fresh, "unknown keys: {jacobi} iterations against {fresh}");
+        assert_eq!(rebuilt, fresh, "rebuilt on schedule");
+    }
+
+    /// A system with no Dirichlet row (the periodic channel's PPE) keeps its coarse
+    /// correction: the coarse null space is grounded.
+    #[test]
+    fn two_level_solves_a_singular_system() {
+        // A periodic 400 × 8 strip: the 5-point Laplacian wrapped along the long axis and
+        // with Neumann rows across (rows sum to zero).
+        let (rows, m) = (400, 8);
+        let mut a = PpeMatrix { row_ptr: vec![0], ..Default::default() };
+        for i in 0..rows {
+            for j in 0..m {
+                let k = i * m + j;
+                let mut off = vec![((i + rows - 1) % rows) * m + j, ((i + 1) % rows) * m + j];
+                if j > 0 {
+                    off.push(k - 1);
+                }
+                if j + 1 < m {
+                    off.push(k + 1);
+                }
+                a.push(k, off.len() as f64);
+                for c in off {
+                    a.push(c, -1.0);
+                }
+                a.end_row();
+            }
+        }
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.013).sin() + 0.3).collect();
+        let keys: Vec<u32> = (0..n as u32).collect();
+        let mut jacobi = PpeSolve::new(PpeOptions {
+            solver: PpeSolver::Cg,
+            tolerance: 1e-10,
+            max_iterations: 20_000,
+            preconditioner: PreconditionerKind::Jacobi,
+            coarse_refresh: 1,
+        });
+        let mut pj = vec![0.0; n];
+        let j = jacobi.solve(&a, &b, &mut pj, true).expect("Jacobi converges").iterations;
+        let (pt, t) = keyed_cg(&mut two_level_cg(25), &a, &b, &keys, true);
+        let err = pj.iter().zip(&pt).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        let scale = pj.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        assert!(err < 1e-7 * scale, "{err} vs {scale}");
+        assert!(pt.iter().sum::<f64>().abs() < 1e-8 * scale * n as f64);
+        assert!(2 * t < j, "two-level {t} iterations, Jacobi {j}");
     }
 
     #[test]
@@ -429,6 +570,7 @@ mod tests {
                 tolerance: 1e-10,
                 max_iterations: 1000,
                 preconditioner: PreconditionerKind::Jacobi,
+                coarse_refresh: 1,
             });
             let mut p = vec![0.0; n];
             let info = s.solve(&a, &b, &mut p, false).unwrap();
@@ -461,6 +603,7 @@ mod tests {
             tolerance: 1e-12,
             max_iterations: 3,
             preconditioner: PreconditionerKind::Jacobi,
+            coarse_refresh: 1,
         });
         let mut p = vec![0.0; a.n()];
         assert!(matches!(s.solve(&a, &b, &mut p, false), Err(Cause::PpeNoConvergence { .. })));
@@ -484,6 +627,7 @@ mod tests {
                 tolerance: 1e-10,
                 max_iterations: 2000,
                 preconditioner: PreconditionerKind::Jacobi,
+                coarse_refresh: 1,
             });
             let mut p = vec![0.0; n];
             let info = s.solve(&a, &b, &mut p, true).unwrap();

@@ -164,6 +164,9 @@ pub struct PpeSystem {
     pub row_of: Vec<u32>,
     /// Particle of each row.
     pub particle_of: Vec<u32>,
+    /// Id of each row's particle (the key of the two-level preconditioner's coarse space;
+    /// filled only when that preconditioner is configured).
+    pub row_key: Vec<u32>,
     /// Unknowns (pressures of the rows) \[Pa\].
     pub solution: Vec<f64>,
     /// True when no row is Dirichlet-constrained (closed or periodic domain).

@@ -38,6 +38,7 @@ fn heap_traffic(scene: &meniscus::Scene, warm: usize, steps: usize, threads: usi
 #[test]
 fn a_warm_step_does_not_allocate() {
     drop_steps();
+    two_level_drop_steps();
     walled_periodic_channel_steps();
 }
 
@@ -54,6 +55,40 @@ fn drop_steps() {
         // The drop stretches: its cell grid (one count and one offset per cell) outgrows
         // its capacity about once here (two reallocations of ~1.5 kB, measured).
         assert!(grown <= 2, "{grown} reallocations in 60 warm steps of the drop, {threads} threads");
+    }
+}
+
+/// The drop with the two-level preconditioner (CG), whose coarse space is kept across
+/// steps: the steps that reuse it allocate nothing; a rebuild (every `coarse_refresh`
+/// solves) allocates inside faer's symbolic Cholesky analysis of the new coarse pattern.
+fn two_level_drop_steps() {
+    let scene = |refresh: usize| {
+        common::drop_scene(|v| {
+            v["dx"] = json!(0.05);
+            v["time"]["end"] = json!(1.0);
+            v["scheme"]["isph"]["ppe"]["solver"] = json!("cg");
+            v["scheme"]["isph"]["ppe"]["preconditioner"] = json!("two_level");
+            v["scheme"]["isph"]["ppe"]["coarse_refresh"] = json!(refresh);
+        })
+    };
+    for threads in [1, 2] {
+        // Built during the warm-up and reused through the 60 steps.
+        let (fresh, grown) = heap_traffic(&scene(1000), 30, 60, threads);
+        assert_eq!(
+            fresh, 0,
+            "{fresh} allocations in 60 warm steps reusing the coarse space, {threads} threads"
+        );
+        assert!(
+            grown <= 2,
+            "{grown} reallocations in 60 warm steps reusing the coarse space, {threads} threads"
+        );
+        // Rebuilt every 25 solves: two rebuilds in these 60 steps (solves 50 and 75), each
+        // with the allocations of faer's symbolic analysis alone (6 measured).
+        let (fresh, _) = heap_traffic(&scene(25), 30, 60, threads);
+        assert!(
+            (1..=2 * 8).contains(&fresh),
+            "{fresh} allocations in 60 steps with two rebuilds, {threads} threads"
+        );
     }
 }
 

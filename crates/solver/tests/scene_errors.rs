@@ -145,6 +145,9 @@ fn malformed_scene_table() {
         }),
         ("scheme.isph.ppe.max_iterations", "", |v| v["scheme"]["isph"]["ppe"]["max_iterations"] = json!(-5)),
         ("scheme.isph.ppe.solver", "", |v| v["scheme"]["isph"]["ppe"]["solver"] = json!("gmres")),
+        ("scheme.isph.ppe.coarse_refresh", "at least 1", |v| {
+            v["scheme"]["isph"]["ppe"]["coarse_refresh"] = json!(0)
+        }),
         ("scheme.isph.free_surface_threshold", "positive", |v| {
             v["scheme"]["isph"]["free_surface_threshold"] = json!(0)
         }),

@@ -1,8 +1,8 @@
 //! The factors of the study, the two presets they vary around, and the pruned design of
 //! each tier.
 //!
-//! The cross product (3 Krylov settings × 2 gradients × 2 divergences × 3 shifting laws ×
-//! 2 time-step rules = 72 option sets) is run at the coarsest spacing only. At every
+//! The cross product (4 Krylov settings × 2 gradients × 2 divergences × 3 shifting laws ×
+//! 2 time-step rules = 96 option sets) is run at the coarsest spacing only. At every
 //! spacing the design is one factor at a time around the `paper` and `tuned` presets of
 //! `validation/elliptical_drop.json`: each preset, and each preset with one factor changed
 //! to each of its other levels. The sparse LU, which refactorises every step, is pruned
@@ -12,7 +12,7 @@
 use crate::case::{Case, Tier};
 use crate::error::{HarnessError, Result};
 use meniscus::Scene;
-use meniscus::scene::{Divergence, PpeSolver, PressureGradient, Scheme, Shifting, TimeStep};
+use meniscus::scene::{Divergence, PpeSolver, Preconditioner, PressureGradient, Scheme, Shifting, TimeStep};
 use serde::{Deserialize, Serialize};
 
 /// PPE solver and tolerance.
@@ -27,6 +27,10 @@ pub enum Ppe {
     /// Conjugate gradient (Jacobi), relative tolerance 1e-3.
     #[serde(rename = "cg_1e-3")]
     Cg3,
+    /// Conjugate gradient with the two-level preconditioner (Jacobi plus a coarse space
+    /// kept across steps), relative tolerance 1e-3: the tuned preset's solver.
+    #[serde(rename = "cg_two_level_1e-3")]
+    CgTwoLevel3,
     /// Sparse LU.
     #[serde(rename = "direct")]
     Direct,
@@ -93,7 +97,7 @@ pub struct Variant {
 }
 
 /// Every level of every factor, in display order.
-const PPES: [Ppe; 4] = [Ppe::Bicgstab3, Ppe::Bicgstab5, Ppe::Cg3, Ppe::Direct];
+const PPES: [Ppe; 5] = [Ppe::CgTwoLevel3, Ppe::Bicgstab3, Ppe::Bicgstab5, Ppe::Cg3, Ppe::Direct];
 const GRADIENTS: [Gradient; 2] = [Gradient::Symmetric, Gradient::Difference];
 const DIVS: [Div; 2] = [Div::Standard, Div::Corrected];
 const SHIFTS: [Shift; 3] = [Shift::None, Shift::Xu, Shift::Fickian];
@@ -110,9 +114,14 @@ impl Variant {
         dt: Dt::Fixed,
     };
 
-    /// The `tuned` preset: the paper's with the corrected divergence and Fickian shifting.
-    pub const TUNED: Variant =
-        Variant { divergence: Div::Corrected, shifting: Shift::Fickian, ..Variant::PAPER };
+    /// The `tuned` preset: the paper's with the corrected divergence, Fickian shifting and
+    /// the PPE (to the same 1e-3) by two-level CG.
+    pub const TUNED: Variant = Variant {
+        ppe: Ppe::CgTwoLevel3,
+        divergence: Div::Corrected,
+        shifting: Shift::Fickian,
+        ..Variant::PAPER
+    };
 
     /// The name of a preset variant (`paper`, `tuned`), if it is one.
     pub fn preset(&self) -> Option<&'static str> {
@@ -131,6 +140,7 @@ impl Variant {
             Ppe::Bicgstab3 => "bicgstab_1e-3",
             Ppe::Bicgstab5 => "bicgstab_1e-5",
             Ppe::Cg3 => "cg_1e-3",
+            Ppe::CgTwoLevel3 => "cg_two_level_1e-3",
             Ppe::Direct => "direct",
         };
         let gradient = match self.gradient {
@@ -153,9 +163,9 @@ impl Variant {
         format!("{ppe} {gradient} {divergence} {shifting} {dt}")
     }
 
-    /// The full cross product of the factors (96 variants).
+    /// The full cross product of the factors (120 variants).
     pub fn all() -> Vec<Variant> {
-        let mut out = Vec::with_capacity(96);
+        let mut out = Vec::with_capacity(120);
         for ppe in PPES {
             for gradient in GRADIENTS {
                 for divergence in DIVS {
@@ -192,11 +202,12 @@ impl Variant {
         let Scheme::Isph(o) = &mut scene.scheme else {
             return; // the variants are ISPH options
         };
-        (o.ppe.solver, o.ppe.tolerance) = match self.ppe {
-            Ppe::Bicgstab3 => (PpeSolver::Bicgstab, 1e-3),
-            Ppe::Bicgstab5 => (PpeSolver::Bicgstab, 1e-5),
-            Ppe::Cg3 => (PpeSolver::Cg, 1e-3),
-            Ppe::Direct => (PpeSolver::Direct, o.ppe.tolerance),
+        (o.ppe.solver, o.ppe.tolerance, o.ppe.preconditioner) = match self.ppe {
+            Ppe::Bicgstab3 => (PpeSolver::Bicgstab, 1e-3, Preconditioner::Jacobi),
+            Ppe::Bicgstab5 => (PpeSolver::Bicgstab, 1e-5, Preconditioner::Jacobi),
+            Ppe::Cg3 => (PpeSolver::Cg, 1e-3, Preconditioner::Jacobi),
+            Ppe::CgTwoLevel3 => (PpeSolver::Cg, 1e-3, Preconditioner::TwoLevel),
+            Ppe::Direct => (PpeSolver::Direct, o.ppe.tolerance, o.ppe.preconditioner),
         };
         o.pressure_gradient = match self.gradient {
             Gradient::Symmetric => PressureGradient::Symmetric,
@@ -268,10 +279,10 @@ impl Design {
     /// The design of `tier` with `threads` threads for the main runs.
     ///
     /// - quick: Δx 0.04 and 0.02; one factor at a time around `tuned` (sparse LU at 0.04
-    ///   only), plus `paper`; the two presets with one thread too (23 runs).
+    ///   only), plus `paper`; the two presets with one thread too (25 runs).
     /// - default: the Krylov cross product at Δx = 0.04; one factor at a time around both
     ///   presets at 0.04, 0.02 and 0.01 (sparse LU at 0.04, and for `paper` at 0.02); both
-    ///   presets with one thread at 0.04, 0.02, 0.01 (109 runs).
+    ///   presets with one thread at 0.04, 0.02, 0.01 (141 runs).
     /// - full: the default design plus both presets at Δx = 0.005.
     pub fn for_tier(tier: Tier, threads: usize) -> Design {
         let mut d = Design {
@@ -302,7 +313,7 @@ impl Design {
                     d.add(0.04, v, threads, "product");
                 }
                 d.description.push(
-                    "Δx = 0.04: the full cross product of the factors with the three Krylov settings (72 option sets).".into(),
+                    "Δx = 0.04: the full cross product of the factors with the four Krylov settings (96 option sets).".into(),
                 );
                 for dx in [0.04, 0.02, 0.01] {
                     for (name, p) in presets {
@@ -414,24 +425,25 @@ mod tests {
     #[test]
     fn design_sizes() {
         let all = Variant::all();
-        assert_eq!(all.len(), 96);
-        assert_eq!(all.iter().collect::<HashSet<_>>().len(), 96);
+        assert_eq!(all.len(), 120);
+        assert_eq!(all.iter().collect::<HashSet<_>>().len(), 120);
         let ofat = Variant::PAPER.one_factor_at_a_time();
-        assert_eq!(ofat.len(), 1 + 3 + 1 + 1 + 2 + 1);
+        assert_eq!(ofat.len(), 1 + 4 + 1 + 1 + 2 + 1);
         assert!(ofat.iter().skip(1).all(|v| *v != Variant::PAPER));
 
         let d = Design::for_tier(Tier::Default, 2);
         let at =
             |dx: f64, t: usize| d.runs.iter().filter(|r| (r.dx - dx).abs() < 1e-12 && r.threads == t).count();
-        // 72 Krylov option sets, and the sparse LU with either preset.
-        assert_eq!(at(0.04, 2), 74);
-        // Paper and tuned share two neighbours (paper + corrected divergence = tuned + Xu,
-        // paper + Fickian = tuned + eq. 10): 16 distinct option sets, one of them with LU.
-        assert_eq!(at(0.02, 2), 15);
-        assert_eq!(at(0.01, 2), 14);
+        // 96 Krylov option sets, and the sparse LU with either preset.
+        assert_eq!(at(0.04, 2), 98);
+        // Paper and tuned differ in three factors (solver, divergence, shifting), so they
+        // share no neighbour: 10 + 9 option sets, the paper's sparse LU among them.
+        assert_eq!(at(0.02, 2), 19);
+        assert_eq!(at(0.01, 2), 18);
         assert!(d.runs.iter().filter(|r| r.variant.ppe == Ppe::Direct).all(|r| r.dx >= 0.02));
         assert_eq!(at(0.01, 1), 2);
         assert_eq!(at(0.005, 2), 0);
+        assert_eq!(d.runs.len(), 141);
         let ids: HashSet<String> = d.runs.iter().map(Planned::id).collect();
         assert_eq!(ids.len(), d.runs.len(), "ids are unique");
         assert!(d.runs.windows(2).all(|w| w[0].dx >= w[1].dx), "coarse first");
@@ -443,7 +455,7 @@ mod tests {
         assert_eq!(full.runs.len(), d.runs.len() + 2);
         let quick = Design::for_tier(Tier::Quick, 2);
         assert!(quick.runs.iter().all(|r| r.dx >= 0.02));
-        assert_eq!(quick.runs.len(), 23);
+        assert_eq!(quick.runs.len(), 25);
         assert_eq!(Design::for_tier(Tier::Quick, 1).thread_counts, vec![1]);
     }
 }

@@ -265,7 +265,7 @@ mod tests {
         assert_eq!((ts[0].value, ts[0].pass), (Some(1.6), Some(false)));
         // Fastest run under 0.5 %: tuned at 0.04 (0.4 s), not the diverged one.
         assert_eq!((ts[1].value, ts[1].pass), (Some(0.4), Some(true)));
-        assert!(ts[1].note.contains("dx0.04_t2_bicgstab_1e-3-sym-corr-fickian-fixed"), "{}", ts[1].note);
+        assert!(ts[1].note.contains("dx0.04_t2_cg_two_level_1e-3-sym-corr-fickian-fixed"), "{}", ts[1].note);
         assert!((ts[2].value.unwrap() - 1.0).abs() < 1e-2, "{:?}", ts[2]);
         assert_eq!(ts[2].pass, Some(true));
         assert!((ts[3].value.unwrap() - 1.5).abs() < 1e-2, "{:?}", ts[3]);

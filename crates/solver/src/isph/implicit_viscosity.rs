@@ -40,6 +40,7 @@ impl ImplicitViscosity {
             tolerance: TOLERANCE,
             max_iterations: 2000,
             preconditioner: Preconditioner::Jacobi,
+            coarse_refresh: 1,
         };
         Self {
             nu,

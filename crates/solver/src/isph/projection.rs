@@ -192,7 +192,16 @@ impl<const D: usize> Stage<D> for PpeSolveStage {
         for (x, &a) in sys.solution.iter_mut().zip(&sys.particle_of) {
             *x = p[a as usize];
         }
-        sys.info = self.solver.solve(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular)?;
+        // The particle ids key the rows for a coarse space kept across steps.
+        let keys = if self.solver.uses_row_keys() {
+            let id = &s.particles.id;
+            sys.row_key.clear();
+            sys.row_key.extend(sys.particle_of.iter().map(|&a| id[a as usize]));
+            Some(&sys.row_key[..])
+        } else {
+            None
+        };
+        sys.info = self.solver.solve_keyed(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular, keys)?;
         // Free-surface particles get p = 0 (or keep their Young–Laplace value); boundary
         // particles keep their known values.
         if !self.surface_pressure {

@@ -531,6 +531,15 @@ pub struct PpeOptions {
     /// Preconditioner of the Krylov solvers (default Jacobi).
     #[serde(default)]
     pub preconditioner: Preconditioner,
+    /// Solves between rebuilds of the two-level preconditioner's coarse space (aggregates
+    /// and factorised coarse matrix, kept across steps: `two_level.rs`); default 25, at
+    /// least 1. Unused with Jacobi.
+    #[serde(default = "default_coarse_refresh")]
+    pub coarse_refresh: usize,
+}
+
+fn default_coarse_refresh() -> usize {
+    crate::two_level::DEFAULT_REFRESH
 }
 
 /// Preconditioners of the Krylov PPE solvers.

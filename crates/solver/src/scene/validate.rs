@@ -223,6 +223,9 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
     if o.ppe.max_iterations == 0 {
         return Err(SceneError::new("scheme.isph.ppe.max_iterations", 0, "must be at least 1"));
     }
+    if o.ppe.coarse_refresh == 0 {
+        return Err(SceneError::new("scheme.isph.ppe.coarse_refresh", 0, "must be at least 1"));
+    }
     let t = o.free_surface_threshold;
     positive("scheme.isph.free_surface_threshold", t)?;
     if t >= d as f64 {
