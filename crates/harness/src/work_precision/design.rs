@@ -1,8 +1,8 @@
 //! The factors of the study, the two presets they vary around, and the pruned design of
 //! each tier.
 //!
-//! The cross product (4 Krylov settings × 2 gradients × 2 divergences × 3 shifting laws ×
-//! 2 time-step rules = 96 option sets) is run at the coarsest spacing only. At every
+//! The cross product (5 Krylov settings × 2 gradients × 2 divergences × 3 shifting laws ×
+//! 2 time-step rules = 120 option sets) is run at the coarsest spacing only. At every
 //! spacing the design is one factor at a time around the `paper` and `tuned` presets of
 //! `validation/elliptical_drop.json`: each preset, and each preset with one factor changed
 //! to each of its other levels. The sparse LU, which refactorises every step, is pruned
@@ -18,6 +18,10 @@ use serde::{Deserialize, Serialize};
 /// PPE solver and tolerance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
 pub enum Ppe {
+    /// BiCGSTAB (Qiu's Krylov method) with the two-level preconditioner, relative tolerance
+    /// 1e-3 (Qiu's): the paper preset's solver.
+    #[serde(rename = "bicgstab_two_level_1e-3")]
+    BicgstabTwoLevel3,
     /// BiCGSTAB (Jacobi), relative tolerance 1e-3 (the paper's).
     #[serde(rename = "bicgstab_1e-3")]
     Bicgstab3,
@@ -97,17 +101,18 @@ pub struct Variant {
 }
 
 /// Every level of every factor, in display order.
-const PPES: [Ppe; 5] = [Ppe::CgTwoLevel3, Ppe::Bicgstab3, Ppe::Bicgstab5, Ppe::Cg3, Ppe::Direct];
+const PPES: [Ppe; 6] =
+    [Ppe::BicgstabTwoLevel3, Ppe::CgTwoLevel3, Ppe::Bicgstab3, Ppe::Bicgstab5, Ppe::Cg3, Ppe::Direct];
 const GRADIENTS: [Gradient; 2] = [Gradient::Symmetric, Gradient::Difference];
 const DIVS: [Div; 2] = [Div::Standard, Div::Corrected];
 const SHIFTS: [Shift; 3] = [Shift::None, Shift::Xu, Shift::Fickian];
 const DTS: [Dt; 2] = [Dt::Fixed, Dt::Adaptive];
 
 impl Variant {
-    /// The `paper` preset: BiCGSTAB 1e-3, symmetric gradient, eq. 10 divergence, Xu
-    /// shifting, fixed Δt.
+    /// The `paper` preset: BiCGSTAB 1e-3 (two-level preconditioner), symmetric gradient,
+    /// eq. 10 divergence, Xu shifting, fixed Δt.
     pub const PAPER: Variant = Variant {
-        ppe: Ppe::Bicgstab3,
+        ppe: Ppe::BicgstabTwoLevel3,
         gradient: Gradient::Symmetric,
         divergence: Div::Standard,
         shifting: Shift::Xu,
@@ -137,6 +142,7 @@ impl Variant {
     /// A short label, e.g. `bicgstab_1e-3 sym std xu fixed`.
     pub fn label(&self) -> String {
         let ppe = match self.ppe {
+            Ppe::BicgstabTwoLevel3 => "bicgstab_two_level_1e-3",
             Ppe::Bicgstab3 => "bicgstab_1e-3",
             Ppe::Bicgstab5 => "bicgstab_1e-5",
             Ppe::Cg3 => "cg_1e-3",
@@ -163,9 +169,9 @@ impl Variant {
         format!("{ppe} {gradient} {divergence} {shifting} {dt}")
     }
 
-    /// The full cross product of the factors (120 variants).
+    /// The full cross product of the factors (144 variants).
     pub fn all() -> Vec<Variant> {
-        let mut out = Vec::with_capacity(120);
+        let mut out = Vec::with_capacity(144);
         for ppe in PPES {
             for gradient in GRADIENTS {
                 for divergence in DIVS {
@@ -203,6 +209,7 @@ impl Variant {
             return; // the variants are ISPH options
         };
         (o.ppe.solver, o.ppe.tolerance, o.ppe.preconditioner) = match self.ppe {
+            Ppe::BicgstabTwoLevel3 => (PpeSolver::Bicgstab, 1e-3, Preconditioner::TwoLevel),
             Ppe::Bicgstab3 => (PpeSolver::Bicgstab, 1e-3, Preconditioner::Jacobi),
             Ppe::Bicgstab5 => (PpeSolver::Bicgstab, 1e-5, Preconditioner::Jacobi),
             Ppe::Cg3 => (PpeSolver::Cg, 1e-3, Preconditioner::Jacobi),
@@ -279,10 +286,10 @@ impl Design {
     /// The design of `tier` with `threads` threads for the main runs.
     ///
     /// - quick: Δx 0.04 and 0.02; one factor at a time around `tuned` (sparse LU at 0.04
-    ///   only), plus `paper`; the two presets with one thread too (25 runs).
+    ///   only), plus `paper`; the two presets with one thread too (27 runs).
     /// - default: the Krylov cross product at Δx = 0.04; one factor at a time around both
     ///   presets at 0.04, 0.02 and 0.01 (sparse LU at 0.04, and for `paper` at 0.02); both
-    ///   presets with one thread at 0.04, 0.02, 0.01 (141 runs).
+    ///   presets with one thread at 0.04, 0.02, 0.01 (169 runs).
     /// - full: the default design plus both presets at Δx = 0.005.
     pub fn for_tier(tier: Tier, threads: usize) -> Design {
         let mut d = Design {
@@ -313,7 +320,7 @@ impl Design {
                     d.add(0.04, v, threads, "product");
                 }
                 d.description.push(
-                    "Δx = 0.04: the full cross product of the factors with the four Krylov settings (96 option sets).".into(),
+                    "Δx = 0.04: the full cross product of the factors with the five Krylov settings (120 option sets).".into(),
                 );
                 for dx in [0.04, 0.02, 0.01] {
                     for (name, p) in presets {
@@ -425,29 +432,30 @@ mod tests {
     #[test]
     fn design_sizes() {
         let all = Variant::all();
-        assert_eq!(all.len(), 120);
-        assert_eq!(all.iter().collect::<HashSet<_>>().len(), 120);
+        assert_eq!(all.len(), 144);
+        assert_eq!(all.iter().collect::<HashSet<_>>().len(), 144);
         let ofat = Variant::PAPER.one_factor_at_a_time();
-        assert_eq!(ofat.len(), 1 + 4 + 1 + 1 + 2 + 1);
+        assert_eq!(ofat.len(), 1 + 5 + 1 + 1 + 2 + 1);
         assert!(ofat.iter().skip(1).all(|v| *v != Variant::PAPER));
 
         let d = Design::for_tier(Tier::Default, 2);
         let at =
             |dx: f64, t: usize| d.runs.iter().filter(|r| (r.dx - dx).abs() < 1e-12 && r.threads == t).count();
-        // 96 Krylov option sets, and the sparse LU with either preset.
-        assert_eq!(at(0.04, 2), 98);
+        // 120 Krylov option sets, and the sparse LU with either preset.
+        assert_eq!(at(0.04, 2), 122);
         // Paper and tuned differ in three factors (solver, divergence, shifting), so they
-        // share no neighbour: 10 + 9 option sets, the paper's sparse LU among them.
-        assert_eq!(at(0.02, 2), 19);
-        assert_eq!(at(0.01, 2), 18);
+        // share no neighbour: 11 + 10 option sets, the paper's sparse LU among them.
+        assert_eq!(at(0.02, 2), 21);
+        assert_eq!(at(0.01, 2), 20);
         assert!(d.runs.iter().filter(|r| r.variant.ppe == Ppe::Direct).all(|r| r.dx >= 0.02));
         assert_eq!(at(0.01, 1), 2);
         assert_eq!(at(0.005, 2), 0);
-        assert_eq!(d.runs.len(), 141);
+        assert_eq!(d.runs.len(), 169);
         let ids: HashSet<String> = d.runs.iter().map(Planned::id).collect();
         assert_eq!(ids.len(), d.runs.len(), "ids are unique");
         assert!(d.runs.windows(2).all(|w| w[0].dx >= w[1].dx), "coarse first");
-        let paper02 = d.runs.iter().find(|r| r.id() == "dx0.02_t2_bicgstab_1e-3-sym-std-xu-fixed").unwrap();
+        let paper02 =
+            d.runs.iter().find(|r| r.id() == "dx0.02_t2_bicgstab_two_level_1e-3-sym-std-xu-fixed").unwrap();
         assert!(paper02.groups.contains(&"ofat:paper".to_string()));
         assert!(paper02.groups.contains(&"threads".to_string()));
 
@@ -455,7 +463,7 @@ mod tests {
         assert_eq!(full.runs.len(), d.runs.len() + 2);
         let quick = Design::for_tier(Tier::Quick, 2);
         assert!(quick.runs.iter().all(|r| r.dx >= 0.02));
-        assert_eq!(quick.runs.len(), 25);
+        assert_eq!(quick.runs.len(), 27);
         assert_eq!(Design::for_tier(Tier::Quick, 1).thread_counts, vec![1]);
     }
 }
