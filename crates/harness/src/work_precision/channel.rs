@@ -7,13 +7,15 @@
 //! Factors, one at a time around each viscous integration (explicit, Qiu eq. 13, bound by
 //! the viscous limit Δt ≤ α_d ρ h²/μ; implicit backward Euler, bound by the CFL limit and
 //! the case's 100 s cap): Xu shifting coefficient (C = 0.02, the case's, or 0.01) and PPE
-//! solver (BiCGSTAB 1e-3, the case's, or CG 1e-3).
+//! solver (BiCGSTAB 1e-3 with Jacobi, the case's, CG 1e-3 with Jacobi, or CG 1e-3 with the
+//! two-level preconditioner, whose coarse null space is grounded: the periodic mirror
+//! channel has no Dirichlet row).
 
 use super::Outcome;
 use crate::case::{Case, Tier};
 use crate::error::{HarnessError, Result};
 use meniscus::Scene;
-use meniscus::scene::schema::{PpeSolver, Scheme, Shifting, ViscousIntegration};
+use meniscus::scene::schema::{PpeSolver, Preconditioner, Scheme, Shifting, ViscousIntegration};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -49,8 +51,7 @@ pub enum ChannelShift {
     Xu001,
 }
 
-/// PPE solver at tolerance 1e-3 (Jacobi preconditioner: the periodic mirror channel has no
-/// Dirichlet row, where the two-level preconditioner keeps Jacobi).
+/// PPE solver and preconditioner at tolerance 1e-3.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum ChannelPpe {
@@ -58,7 +59,12 @@ pub enum ChannelPpe {
     Bicgstab,
     /// Conjugate gradient.
     Cg,
+    /// Conjugate gradient with the two-level preconditioner.
+    CgTwoLevel,
 }
+
+/// Every PPE level, in display order.
+const CHANNEL_PPES: [ChannelPpe; 3] = [ChannelPpe::Bicgstab, ChannelPpe::Cg, ChannelPpe::CgTwoLevel];
 
 /// One option set of the channel study.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -105,21 +111,22 @@ impl ChannelVariant {
         let p = match self.ppe {
             ChannelPpe::Bicgstab => "bicgstab_1e-3",
             ChannelPpe::Cg => "cg_1e-3",
+            ChannelPpe::CgTwoLevel => "cg_two_level_1e-3",
         };
         format!("{v} {s} {p}")
     }
 
-    /// This variant and its one-factor changes (shifting, then PPE solver).
+    /// This variant and its one-factor changes (shifting, then each other PPE solver).
     pub fn one_factor_at_a_time(&self) -> Vec<ChannelVariant> {
         let shifting = match self.shifting {
             ChannelShift::Xu002 => ChannelShift::Xu001,
             ChannelShift::Xu001 => ChannelShift::Xu002,
         };
-        let ppe = match self.ppe {
-            ChannelPpe::Bicgstab => ChannelPpe::Cg,
-            ChannelPpe::Cg => ChannelPpe::Bicgstab,
-        };
-        vec![*self, ChannelVariant { shifting, ..*self }, ChannelVariant { ppe, ..*self }]
+        let mut out = vec![*self, ChannelVariant { shifting, ..*self }];
+        out.extend(
+            CHANNEL_PPES.iter().filter(|&&p| p != self.ppe).map(|&ppe| ChannelVariant { ppe, ..*self }),
+        );
+        out
     }
 
     /// Applies the variant to a channel scene (an ISPH scene; others are left alone).
@@ -138,10 +145,12 @@ impl ChannelVariant {
             },
             smooth: false,
         };
-        (o.ppe.solver, o.ppe.tolerance) = match self.ppe {
-            ChannelPpe::Bicgstab => (PpeSolver::Bicgstab, 1e-3),
-            ChannelPpe::Cg => (PpeSolver::Cg, 1e-3),
+        (o.ppe.solver, o.ppe.preconditioner) = match self.ppe {
+            ChannelPpe::Bicgstab => (PpeSolver::Bicgstab, Preconditioner::Jacobi),
+            ChannelPpe::Cg => (PpeSolver::Cg, Preconditioner::Jacobi),
+            ChannelPpe::CgTwoLevel => (PpeSolver::Cg, Preconditioner::TwoLevel),
         };
+        o.ppe.tolerance = 1e-3;
     }
 }
 
@@ -166,8 +175,8 @@ impl ChannelPlanned {
 /// The channel runs of a tier, coarse spacings first:
 /// - quick: D/36, both viscous integrations with the case's other options (2 runs);
 /// - default: D/36 and 0.004, each viscous integration and its one-factor changes
-///   (12 runs);
-/// - full: the default design at D/36, 0.004 and 0.0025 (18 runs).
+///   (16 runs);
+/// - full: the default design at D/36, 0.004 and 0.0025 (24 runs).
 pub fn design(tier: Tier, threads: usize) -> (Vec<ChannelPlanned>, String) {
     let (spacings, variants): (&[f64], Vec<ChannelVariant>) = match tier {
         Tier::Quick => (&[D36], vec![ChannelVariant::EXPLICIT, ChannelVariant::IMPLICIT]),
@@ -185,7 +194,7 @@ pub fn design(tier: Tier, threads: usize) -> (Vec<ChannelPlanned>, String) {
     let which = if tier == Tier::Quick {
         "explicit and implicit viscosity with the case's options"
     } else {
-        "explicit and implicit viscosity, each with Xu C = 0.01 instead of 0.02 and with CG instead of BiCGSTAB"
+        "explicit and implicit viscosity, each with Xu C = 0.01 instead of 0.02, and with CG (Jacobi) and two-level CG instead of BiCGSTAB (Jacobi)"
     };
     (runs, format!("Periodic channel (Re = 4, to τ = 1), Δx = {dx}: {which}."))
 }
@@ -355,7 +364,12 @@ mod tests {
         let Scheme::Isph(o) = &s.scheme else { panic!("an ISPH scene") };
         assert_eq!(o.shifting, Shifting::Xu { coefficient: 0.01, smooth: false });
         assert_eq!(o.ppe.solver, PpeSolver::Cg);
+        assert_eq!(o.ppe.preconditioner, Preconditioner::Jacobi);
         assert_eq!(o.viscosity, ViscousIntegration::Implicit);
+        let s = scene(&c, &ChannelVariant { ppe: ChannelPpe::CgTwoLevel, ..ChannelVariant::EXPLICIT }, D36)
+            .unwrap();
+        let Scheme::Isph(o) = &s.scheme else { panic!("an ISPH scene") };
+        assert_eq!((o.ppe.solver, o.ppe.preconditioner), (PpeSolver::Cg, Preconditioner::TwoLevel));
     }
 
     #[test]
@@ -363,12 +377,13 @@ mod tests {
         let (quick, _) = design(Tier::Quick, 2);
         assert_eq!(quick.len(), 2);
         let (default, text) = design(Tier::Default, 2);
-        assert_eq!(default.len(), 12);
+        assert_eq!(default.len(), 16);
         assert!(text.contains("0.00400"));
         let (full, _) = design(Tier::Full, 2);
-        assert_eq!(full.len(), 18);
+        assert_eq!(full.len(), 24);
         let ids: HashSet<String> = full.iter().map(ChannelPlanned::id).collect();
-        assert_eq!(ids.len(), 18, "ids are unique");
+        assert_eq!(ids.len(), 24, "ids are unique");
+        assert!(full.iter().any(|r| r.variant.ppe == ChannelPpe::CgTwoLevel));
         assert!(full.windows(2).all(|w| w[0].dx >= w[1].dx), "coarse first");
     }
 }
