@@ -173,9 +173,26 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
     for fit in cost_fits(runs, threads) {
         let note = match (fit.exponent, fit.dx.first(), fit.dx.last()) {
             (Some(_), Some(&coarse), Some(&fine)) => {
-                // A spacing of the tier that diverged is not in the fit: say so.
+                // A spacing of the tier that diverged is not in the fit: say so, and what
+                // the fit would be with that run's cost per step over the steps it took.
                 let missing = if fine > finest_dx + 1e-12 {
-                    format!("; Δx = {finest_dx} did not finish")
+                    let stopped = runs.iter().find(|r| r.is(&fit.preset, finest_dx, threads) && !r.ok());
+                    match stopped.and_then(|r| r.cost_per_step().map(|c| (r, c))) {
+                        Some((r, c)) => {
+                            let mut n: Vec<f64> = fit.particles.iter().map(|&p| p as f64).collect();
+                            let mut cost = fit.cost_per_step_s.clone();
+                            n.push(r.particles as f64);
+                            cost.push(c);
+                            let with = fit_power_law(&n, &cost).map_or(String::new(), |f| {
+                                format!("; with its cost per step over them, {:.3}", f.order)
+                            });
+                            format!(
+                                "; Δx = {finest_dx} did not finish: it stopped after {} steps{with}",
+                                r.steps
+                            )
+                        }
+                        None => format!("; Δx = {finest_dx} did not finish"),
+                    }
                 } else {
                     String::new()
                 };
@@ -302,13 +319,20 @@ mod tests {
             row(p, 0.01, 2, 6.4, Some(0.008)),
         ];
         runs[2].status = "diverged: guard at step 870".into();
+        runs[2].steps = 200;
         let ts = evaluate(&runs, 2, 0.01);
         assert!((ts[2].value.unwrap() - 1.0).abs() < 1e-2, "{:?}", ts[2]);
         assert!(
-            ts[2].note.contains("over 2 spacings (Δx 0.04 → 0.02; Δx = 0.01 did not finish"),
+            ts[2].note.contains(
+                "over 2 spacings (Δx 0.04 → 0.02; Δx = 0.01 did not finish: it stopped after 200 steps"
+            ),
             "{}",
             ts[2].note
         );
+        // 6.4 s over 200 steps is twice the cost per step of a linear law: exponent 1.25 with it.
+        let with: f64 =
+            ts[2].note.split("with its cost per step over them, ").nth(1).unwrap()[..5].parse().unwrap();
+        assert!(with > 1.1 && with < 1.4, "{}", ts[2].note);
     }
 
     #[test]
