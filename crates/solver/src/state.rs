@@ -44,19 +44,30 @@ impl<const D: usize> Particles<D> {
 
 /// Geometry of one neighbour pair (a, b) at the current positions, computed once per step
 /// and shared by the stages, so that `∇_a W_ab = f · r_ab`.
+///
+/// 24 bytes in 2D: `|r_ab|²` is recomputed from `r_ab` where a stage needs it (the same
+/// operation as when the pair was made, so the same bits) instead of stored, because the
+/// pair passes stream the whole cache from memory once it outgrows the last-level cache
+/// (the drop at Δx = 0.005: 3.5 million pairs).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Pair<const D: usize> {
     /// r_a − r_b (minimum image on periodic axes) \[m\].
     pub r_ab: Vector<D>,
-    /// |r_ab|² \[m²\].
-    pub r2: f64,
     /// f = W'(r)/r \[1/m^(D+2)\] (≤ 0; zero beyond the support).
     pub f: f64,
 }
 
+impl<const D: usize> Pair<D> {
+    /// |r_ab|² \[m²\].
+    #[inline(always)]
+    pub fn r2(&self) -> f64 {
+        self.r_ab.norm_squared()
+    }
+}
+
 impl<const D: usize> Default for Pair<D> {
     fn default() -> Self {
-        Self { r_ab: Vector::zeros(), r2: 0.0, f: 0.0 }
+        Self { r_ab: Vector::zeros(), f: 0.0 }
     }
 }
 

@@ -77,7 +77,7 @@ fn laplacian<const D: usize, const N: usize>(
     let mut shao_lo = Vector::<D>::zeros();
     for (p, &b) in pairs.iter().zip(nbrs) {
         let r = p.r_ab;
-        let fq = p.f / (p.r2 + eta2);
+        let fq = p.f / (p.r2() + eta2);
         let du = u[a] - u[b as usize];
         let s = SVector::<f64, N>::from_fn(|k, _| r[sym[k].0] * r[sym[k].1]);
         let s_prime = SVector::<f64, N>::from_fn(|k, _| if sym[k].0 == sym[k].1 { s[k] } else { 2.0 * s[k] });
@@ -85,7 +85,7 @@ fn laplacian<const D: usize, const N: usize>(
         let fqs = s * fq;
         m += fr * r.transpose();
         grad -= fr * du.transpose();
-        shao_lo += du * (fq * p.r2);
+        shao_lo += du * (fq * p.r2());
         q += fqs * s_prime.transpose();
         r_t += fqs * r.transpose();
         s0 += fqs * du.transpose();
@@ -167,7 +167,7 @@ mod tests {
                     continue;
                 }
                 // r_ab = r_a − r_b with a at the origin.
-                pairs.push(Pair { r_ab: Vector::<2>::new(-x, -y), r2, f: kernel.grad_factor(r2.sqrt()) });
+                pairs.push(Pair { r_ab: Vector::<2>::new(-x, -y), f: kernel.grad_factor(r2.sqrt()) });
                 nbrs.push(u.len() as u32);
                 u.push(Vector::<2>::new(phi(x, y), 2.0 * phi(x, y)));
             }
@@ -195,7 +195,7 @@ mod tests {
         let eta2 = 0.01 * 0.0225;
         let mut shao_lo = 0.0;
         for (p, &b) in pairs.iter().zip(&nbrs) {
-            shao_lo += (u[0][0] - u[b as usize][0]) * p.f * p.r2 / (p.r2 + eta2) * 2.0 * v;
+            shao_lo += (u[0][0] - u[b as usize][0]) * p.f * p.r2() / (p.r2() + eta2) * 2.0 * v;
         }
         assert!((shao_lo - 4.0).abs() > 0.02, "Shao–Lo {shao_lo}");
         let lap = laplacian::<2, 3>(0, &pairs, &nbrs, &u, eta2, v);
@@ -227,7 +227,7 @@ mod tests {
                     if (i, j, l) == (0, 0, 0) || r >= kernel.support {
                         continue;
                     }
-                    pairs.push(Pair { r_ab: -x, r2: r * r, f: kernel.grad_factor(r) });
+                    pairs.push(Pair { r_ab: -x, f: kernel.grad_factor(r) });
                     nbrs.push(u.len() as u32);
                     u.push(Vector::<3>::repeat(phi(x)));
                 }

@@ -94,7 +94,7 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                 // −Δt ν L: w = −c (r·∇W)/(r² + η²) ≥ 0 per pair, (u_a − u_b) w; rounded as
                 // stored, here and in the diagonal (see `PpeMatrix`).
-                let w = stored(-c * p.f * p.r2 / (p.r2 + eta2));
+                let w = stored(-c * p.f * p.r2() / (p.r2() + eta2));
                 *diag += w;
                 match column(b as usize) {
                     Some((col, f)) if col as usize == a => *diag -= w * f,
@@ -116,7 +116,7 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
                 let mut known = 0.0;
                 for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                     if column(b as usize).is_none() {
-                        known += -c * p.f * p.r2 / (p.r2 + eta2) * u_old[b as usize][k];
+                        known += -c * p.f * p.r2() / (p.r2() + eta2) * u_old[b as usize][k];
                     }
                 }
                 *r = u[a][k] + known;

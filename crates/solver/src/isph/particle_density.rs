@@ -47,7 +47,7 @@ impl<K: Kernel, const D: usize> Stage<D> for ParticleDensity<K, D> {
             (&s.neighbours, &s.pairs, &self.kernel, self.self_term, self.scale);
         s.particle_density.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, d)| {
             let row = &pairs[list.offsets[a]..list.offsets[a + 1]];
-            *d = scale * (w0 + row.iter().map(|p| kernel.w(p.r2.sqrt())).sum::<f64>());
+            *d = scale * (w0 + row.iter().map(|p| kernel.w(p.r2().sqrt())).sum::<f64>());
         });
         Ok(())
     }

@@ -52,7 +52,7 @@ impl<const D: usize> Stage<D> for Viscosity {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let mut lap = Vector::<D>::zeros();
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                lap += (u_old[a] - u_old[b as usize]) * (p.f * p.r2 / (p.r2 + eta2));
+                lap += (u_old[a] - u_old[b as usize]) * (p.f * p.r2() / (p.r2() + eta2));
             }
             *u = u_old[a] + lap * c;
         });
@@ -84,7 +84,7 @@ impl<const D: usize> Stage<D> for CentralViscosity {
             let mut acc = Vector::<D>::zeros();
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                 let u_ab = u_old[a] - u_old[b as usize];
-                acc += p.r_ab * (u_ab.dot(&p.r_ab) * p.f / (p.r2 + eta2));
+                acc += p.r_ab * (u_ab.dot(&p.r_ab) * p.f / (p.r2() + eta2));
             }
             *u = u_old[a] + acc * c;
         });

@@ -109,7 +109,7 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                     continue;
                 }
                 // Rounded as stored, here and in the diagonal (see `PpeMatrix`).
-                let c = stored(-2.0 * v * p.f * p.r2 / (rho * (p.r2 + eta2)));
+                let c = stored(-2.0 * v * p.f * p.r2() / (rho * (p.r2() + eta2)));
                 *diag += c;
                 if rb != u32::MAX {
                     (cols[k], vals[k]) = (rb, -c as f32);
@@ -154,7 +154,7 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                     let boundary = b as usize >= n && known_boundary;
                     let surface = (b as usize) < n && surface_pressure;
                     if (boundary || surface) && row_of[b as usize] == u32::MAX {
-                        known += -2.0 * v * pr.f * pr.r2 / (rho * (pr.r2 + eta2)) * p[b as usize];
+                        known += -2.0 * v * pr.f * pr.r2() / (rho * (pr.r2() + eta2)) * p[b as usize];
                     }
                 }
             }

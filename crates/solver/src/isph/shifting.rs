@@ -113,7 +113,8 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
                 let mut w_sum = 0.0;
                 let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
                 for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                    if p.r2 == 0.0 {
+                    let r2 = p.r2();
+                    if r2 == 0.0 {
                         continue;
                     }
                     let grad = p.r_ab * (v * p.f);
@@ -122,14 +123,14 @@ impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
                     m -= p.r_ab * grad.transpose();
                     if xu {
                         // n_ab / r_ab² (r̄² applied after the loop).
-                        let r = p.r2.sqrt();
+                        let r = r2.sqrt();
                         if smooth {
-                            let w = (1.0 - p.r2 * inv_support2).max(0.0).powi(2);
-                            xu_sum += p.r_ab * (w / (p.r2 * r));
+                            let w = (1.0 - r2 * inv_support2).max(0.0).powi(2);
+                            xu_sum += p.r_ab * (w / (r2 * r));
                             r_sum += w * r;
                             w_sum += w;
                         } else {
-                            xu_sum += p.r_ab / (p.r2 * r);
+                            xu_sum += p.r_ab / (r2 * r);
                             r_sum += r;
                             w_sum += 1.0;
                         }

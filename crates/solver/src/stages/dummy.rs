@@ -126,7 +126,7 @@ impl<K: Kernel, const D: usize> Stage<D> for DummyWalls<K, D> {
                 if f >= nf {
                     continue;
                 }
-                let wt = k.w(pair.r2.sqrt());
+                let wt = k.w(pair.r2().sqrt());
                 sw += wt;
                 su += u[f] * wt;
                 // r_wf = r_w − r_f = r_ab of this row.

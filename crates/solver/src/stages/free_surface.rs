@@ -28,7 +28,7 @@ impl<const D: usize> Stage<D> for FreeSurface {
             |(a, (d, fs))| {
                 let row = &pairs[list.offsets[a]..list.offsets[a + 1]];
                 // r_ab · ∇_a W_ab = f r².
-                *d = -v * row.iter().map(|p| p.f * p.r2).sum::<f64>();
+                *d = -v * row.iter().map(|p| p.f * p.r2()).sum::<f64>();
                 *fs = *d < t;
             },
         );

@@ -50,7 +50,7 @@ impl<K: Kernel, const D: usize> Stage<D> for Neighbours<K, D> {
             for (pair, &b) in row.iter_mut().zip(list.of(a)) {
                 let r_ab = dom.displacement(&x[a], &x[b as usize]);
                 let r2 = r_ab.norm_squared();
-                *pair = Pair { r_ab, r2, f: k.grad_factor(r2.sqrt()) };
+                *pair = Pair { r_ab, f: k.grad_factor(r2.sqrt()) };
             }
         });
         Ok(())

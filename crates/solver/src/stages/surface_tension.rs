@@ -217,7 +217,7 @@ impl<const D: usize> Stage<D> for SurfaceTension<D> {
                         if let Some(nb) = unit(b) {
                             let vb = vol(b);
                             num += vb * p.f * (nb - na).dot(&p.r_ab);
-                            den += vb * p.f * p.r2;
+                            den += vb * p.f * p.r2();
                         }
                     }
                     let kappa = if den < 0.0 { D as f64 * num / den } else { 0.0 };

@@ -101,7 +101,7 @@ fn surface_curvature<K: Kernel, const D: usize>(
         };
         // Tangential separation r_b − r_a projected on the tangent space of a.
         let t = proj * (-p.r_ab);
-        let w = kernel.w(p.r2.sqrt());
+        let w = kernel.w(p.r2().sqrt());
         g += (nb - na) * t.transpose() * w;
         m += t * t.transpose() * w;
     }
@@ -160,7 +160,7 @@ fn shepard<K: Kernel, const D: usize>(s: &State<D>, kernel: &Scaled<K, D>, raw: 
             if let Some(&kb) = raw.get(b as usize)
                 && kb.is_finite()
             {
-                let w = kernel.w(p.r2.sqrt());
+                let w = kernel.w(p.r2().sqrt());
                 num += w * kb;
                 den += w;
             }

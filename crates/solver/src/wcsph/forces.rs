@@ -119,7 +119,7 @@ impl<K: Kernel, const D: usize, const DIFF: bool, const CORR: bool> Stage<D>
                 }
                 if DIFF {
                     let rb = rho[b];
-                    sum += diff_c * (ra - rb) * pair.f * pair.r2 / ((pair.r2 + eta2) * rb);
+                    sum += diff_c * (ra - rb) * pair.f * pair.r2() / ((pair.r2() + eta2) * rb);
                 }
             }
             if CORR {
@@ -207,13 +207,13 @@ impl<const D: usize, const AV: bool, const VISC: bool> Stage<D> for Momentum<D, 
                     if AV {
                         let vr = u_ab.dot(&pair.r_ab);
                         if vr < 0.0 {
-                            let mu_ab = prm.h * vr / (pair.r2 + eta2);
+                            let mu_ab = prm.h * vr / (pair.r2() + eta2);
                             s_grad -= m * (-ac * mu_ab + bc * mu_ab * mu_ab) * 2.0 / (ra + rb);
                         }
                     }
                     if VISC {
                         let rs = ra + rb;
-                        sum += u_ab * (visc_c * pair.f * pair.r2 / ((pair.r2 + eta2) * rs * rs));
+                        sum += u_ab * (visc_c * pair.f * pair.r2() / ((pair.r2() + eta2) * rs * rs));
                     }
                 }
                 sum += pair.r_ab * (pair.f * s_grad);
