@@ -16,8 +16,8 @@ pub enum Rows {
 }
 
 /// Rebuilds the neighbour lists at the current positions (rows for the particles `rows`
-/// selects; their neighbours include boundary particles) and fills the pair cache (`r_ab`,
-/// `r²`, `W'(r)/r`).
+/// selects; their neighbours include boundary particles) and fills the pair cache (`r_ab`
+/// and `W'(r)/r`).
 #[derive(Debug)]
 pub struct Neighbours<K: Kernel, const D: usize> {
     search: CellSearch<D>,
