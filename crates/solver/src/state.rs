@@ -171,6 +171,8 @@ pub struct PpeSystem {
     pub matrix: crate::ppe::PpeMatrix,
     /// Right-hand side `−div u* / Δt` \[Pa/m² per kg/m³\].
     pub rhs: Vec<f64>,
+    /// (diagonal, right-hand side) of each row as the assembly's pair pass leaves them.
+    pub row_out: Vec<[f64; 2]>,
     /// Row of each particle (`u32::MAX` for free-surface particles).
     pub row_of: Vec<u32>,
     /// Particle of each row.

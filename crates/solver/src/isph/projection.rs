@@ -97,10 +97,18 @@ impl<const D: usize> Stage<D> for PpeAssemble {
         m.resize_entries();
         let (v, rho, eta2) = (s.volume, s.density, 0.01 * s.h * s.h);
         let pairs = &s.pairs;
-        let row = |i, cols: &mut [u32], vals: &mut [f32], diag: &mut f64| {
+        let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
+        self.dt_max = self.dt_max.max(ctx.dt);
+        let (p, density, relaxation, dt_max) =
+            (&s.particles.p, &s.particle_density, self.relaxation, self.dt_max);
+        let surface_pressure = self.surface_pressure;
+        // One pass over each row's pairs: the matrix row, then (the pairs still in cache)
+        // the right-hand side; `row_out` holds (A_ii, b_i) until the diagonal pass below.
+        sys.row_out.resize(rows, [0.0; 2]);
+        let row = |i, cols: &mut [u32], vals: &mut [f32], out: &mut [f64; 2]| {
             let a = particle_of[i] as usize;
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
-            *diag = 0.0;
+            let mut diag = 0.0;
             let mut k = 0;
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                 let rb = row_of[b as usize];
@@ -109,25 +117,14 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                     continue;
                 }
                 // Rounded as stored, here and in the diagonal (see `PpeMatrix`).
-                let c = stored(-2.0 * v * p.f * p.r2() / (rho * (p.r2() + eta2)));
-                *diag += c;
+                let r2 = p.r2();
+                let c = stored(-2.0 * v * p.f * r2 / (rho * (r2 + eta2)));
+                diag += c;
                 if rb != u32::MAX {
                     (cols[k], vals[k]) = (rb, -c as f32);
                     k += 1;
                 }
             }
-        };
-        par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut m.diag, &row);
-        m.invert_diagonal();
-        sys.rhs.resize(rows, 0.0);
-        let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
-        self.dt_max = self.dt_max.max(ctx.dt);
-        let (p, density, relaxation, dt_max) =
-            (&s.particles.p, &s.particle_density, self.relaxation, self.dt_max);
-        let surface_pressure = self.surface_pressure;
-        sys.rhs.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
-            let a = particle_of[i] as usize;
-            let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let div = if corrected {
                 let mut g = SMatrix::<f64, D, D>::zeros();
                 let mut m = SMatrix::<f64, D, D>::zeros();
@@ -154,7 +151,8 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                     let boundary = b as usize >= n && known_boundary;
                     let surface = (b as usize) < n && surface_pressure;
                     if (boundary || surface) && row_of[b as usize] == u32::MAX {
-                        known += -2.0 * v * pr.f * pr.r2() / (rho * (pr.r2() + eta2)) * p[b as usize];
+                        let r2 = pr.r2();
+                        known += -2.0 * v * pr.f * r2 / (rho * (r2 + eta2)) * p[b as usize];
                     }
                 }
             }
@@ -162,8 +160,21 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                 Some(alpha) => alpha * (density[a] - 1.0) * inv_dt / dt_max,
                 None => 0.0,
             };
-            *r = -div * inv_dt + known + relax;
-        });
+            *out = [diag, -div * inv_dt + known + relax];
+        };
+        par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut sys.row_out, &row);
+        m.diag.resize(rows, 0.0);
+        m.inv_diag.resize(rows, 0.0);
+        sys.rhs.resize(rows, 0.0);
+        m.diag
+            .par_iter_mut()
+            .zip(m.inv_diag.par_iter_mut())
+            .zip(sys.rhs.par_iter_mut())
+            .zip(sys.row_out.par_iter())
+            .with_min_len(512)
+            .for_each(|(((d, inv), r), out)| {
+                (*d, *inv, *r) = (out[0], 1.0 / out[0], out[1]);
+            });
         Ok(())
     }
 }
