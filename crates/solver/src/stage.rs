@@ -23,30 +23,38 @@ pub trait Stage<const D: usize>: Send + std::fmt::Debug {
     fn run(&mut self, state: &mut State<D>, ctx: &StepContext) -> Result<(), Cause>;
 }
 
-/// Calls `f(a, row)` for every particle `a` with `row = data[offsets[a]..offsets[a + 1]]`,
-/// in parallel by recursive halving (no allocation; each row is written by one task).
-pub fn par_rows_mut<T: Send, F: Fn(usize, &mut [T]) + Sync>(offsets: &[usize], data: &mut [T], f: &F) {
-    fn rec<T: Send, F: Fn(usize, &mut [T]) + Sync>(
+/// Calls `f(a, row, &mut out[a])` for every particle `a` with
+/// `row = data[offsets[a]..offsets[a + 1]]`, in parallel by recursive halving (no
+/// allocation; each row and its output are written by one task).
+pub fn par_rows_mut<T: Send, U: Send, F: Fn(usize, &mut [T], &mut U) + Sync>(
+    offsets: &[usize],
+    data: &mut [T],
+    out: &mut [U],
+    f: &F,
+) {
+    fn rec<T: Send, U: Send, F: Fn(usize, &mut [T], &mut U) + Sync>(
         lo: usize,
         hi: usize,
         offsets: &[usize],
         data: &mut [T],
+        out: &mut [U],
         f: &F,
     ) {
         if hi - lo <= 256 {
             let base = offsets[lo];
-            for a in lo..hi {
-                f(a, &mut data[offsets[a] - base..offsets[a + 1] - base]);
+            for (a, o) in (lo..hi).zip(out) {
+                f(a, &mut data[offsets[a] - base..offsets[a + 1] - base], o);
             }
         } else {
             let mid = lo + (hi - lo) / 2;
             let (l, r) = data.split_at_mut(offsets[mid] - offsets[lo]);
-            rayon::join(|| rec(lo, mid, offsets, l, f), || rec(mid, hi, offsets, r, f));
+            let (ol, or) = out.split_at_mut(mid - lo);
+            rayon::join(|| rec(lo, mid, offsets, l, ol, f), || rec(mid, hi, offsets, r, or, f));
         }
     }
     let n = offsets.len().saturating_sub(1);
     if n > 0 {
-        rec(0, n, offsets, data, f);
+        rec(0, n, offsets, data, &mut out[..n], f);
     }
 }
 

@@ -52,14 +52,15 @@ pub fn build_stages<K: Kernel, const D: usize>(
         stages.push(Box::new(walls::Walls::new(&scene.boundaries.walls, kernel.support)));
     }
     let rows = if walls == Some(WallModel::Dummy) { Rows::All } else { Rows::Fluid };
-    stages.push(Box::new(Neighbours::new(kernel, domain, rows)));
+    // `div r` for the free-surface flags is summed in the neighbours' pair pass.
+    stages.push(Box::new(Neighbours::new(kernel, domain, rows).summing_div_r()));
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Start)));
     }
     if open.is_some() {
         stages.push(Box::new(InletSources));
     }
-    stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold }));
+    stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold, summed: true }));
     // Explicit: u* = uⁿ + Δt ν L(uⁿ), then + Δt g. Implicit: uⁿ + Δt g first, then the
     // solve (the force inside it keeps the steady state exact).
     let nu = scene.fluid.viscosity / scene.fluid.density;

@@ -12,6 +12,9 @@ use rayon::prelude::*;
 pub struct FreeSurface {
     /// Threshold on `div r`.
     pub threshold: f64,
+    /// `div r` was summed by the `neighbours` stage of this step
+    /// ([`crate::stages::neighbours::Neighbours::summing_div_r`]): only the flags are set here.
+    pub summed: bool,
 }
 
 impl<const D: usize> Stage<D> for FreeSurface {
@@ -24,6 +27,10 @@ impl<const D: usize> Stage<D> for FreeSurface {
         s.div_r.resize(n, 0.0);
         s.free_surface.resize(n, false);
         let (v, list, pairs, t) = (s.volume, &s.neighbours, &s.pairs, self.threshold);
+        if self.summed {
+            s.free_surface.par_iter_mut().zip(&s.div_r).with_min_len(1024).for_each(|(fs, d)| *fs = *d < t);
+            return Ok(());
+        }
         s.div_r.par_iter_mut().zip(s.free_surface.par_iter_mut()).enumerate().with_min_len(256).for_each(
             |(a, (d, fs))| {
                 let row = &pairs[list.offsets[a]..list.offsets[a + 1]];

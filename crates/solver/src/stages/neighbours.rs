@@ -17,18 +17,29 @@ pub enum Rows {
 
 /// Rebuilds the neighbour lists at the current positions (rows for the particles `rows`
 /// selects; their neighbours include boundary particles) and fills the pair cache (`r_ab`
-/// and `W'(r)/r`).
+/// and `W'(r)/r`); with [`Neighbours::summing_div_r`], also `div r` (Qiu 2013 eq. 16 as
+/// corrected by CASES.md erratum 3) while each row's pairs are in cache, for the
+/// `free_surface` stage to threshold.
 #[derive(Debug)]
 pub struct Neighbours<K: Kernel, const D: usize> {
     search: CellSearch<D>,
     kernel: Scaled<K, D>,
     rows: Rows,
+    div_r: bool,
 }
 
 impl<K: Kernel, const D: usize> Neighbours<K, D> {
     /// A stage for `kernel` in `domain`; search radius = kernel support.
     pub fn new(kernel: Scaled<K, D>, domain: crate::neighbours::Domain<D>, rows: Rows) -> Self {
-        Self { search: CellSearch::new(kernel.support, domain), kernel, rows }
+        Self { search: CellSearch::new(kernel.support, domain), kernel, rows, div_r: false }
+    }
+
+    /// Also sums `div r_a = −Σ_b V_b r_ab · ∇_a W_ab` into `State::div_r` (one pass over
+    /// the pairs fewer than a separate sum: 0.19 of 4.9 ms per step on the drop at
+    /// Δx = 0.02, 2 threads).
+    pub fn summing_div_r(mut self) -> Self {
+        self.div_r = true;
+        self
     }
 }
 
@@ -45,12 +56,18 @@ impl<K: Kernel, const D: usize> Stage<D> for Neighbours<K, D> {
         self.search.build_rows(&s.particles.x, rows, &mut s.neighbours);
         let n_pairs = s.neighbours.pairs();
         s.pairs.resize(n_pairs, Pair::default());
-        let (x, list, dom, k) = (&s.particles.x, &s.neighbours, s.domain, self.kernel);
-        par_rows_mut(&list.offsets, &mut s.pairs, &|a, row: &mut [Pair<D>]| {
+        let (x, list, dom, k, v, div_r) =
+            (&s.particles.x, &s.neighbours, s.domain, self.kernel, s.volume, self.div_r);
+        s.div_r.resize(rows, 0.0);
+        par_rows_mut(&list.offsets, &mut s.pairs, &mut s.div_r, &|a, row: &mut [Pair<D>], d: &mut f64| {
             for (pair, &b) in row.iter_mut().zip(list.of(a)) {
                 let r_ab = dom.displacement(&x[a], &x[b as usize]);
                 let r2 = r_ab.norm_squared();
                 *pair = Pair { r_ab, f: k.grad_factor(r2.sqrt()) };
+            }
+            if div_r {
+                // r_ab · ∇_a W_ab = f r².
+                *d = -v * row.iter().map(|p| p.f * p.r2()).sum::<f64>();
             }
         });
         Ok(())

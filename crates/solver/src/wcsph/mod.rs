@@ -109,7 +109,7 @@ pub fn build_stages<K: Kernel, const D: usize>(
     if let Some(law) = Law::of(opts.shifting) {
         // The pairs are those of this step's positions (the kick moves no particle).
         let threshold = D as f64 - 0.5;
-        stages.push(Box::new(FreeSurface { threshold }));
+        stages.push(Box::new(FreeSurface { threshold, summed: false }));
         stages.push(Box::new(crate::isph::shifting::Shifting::new(law, kernel, threshold)));
     }
     stages
