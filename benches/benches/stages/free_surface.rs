@@ -1,4 +1,5 @@
-//! Free-surface detection: `div r` and the flags (pairs per second).
+//! Free-surface detection: the flags from `div r` (summed by the neighbours stage, whose
+//! bench includes that sum), per pair as the other stages.
 
 use crate::{Per, bench_stage};
 use criterion::Criterion;

@@ -60,7 +60,7 @@ pub fn build_stages<K: Kernel, const D: usize>(
     if open.is_some() {
         stages.push(Box::new(InletSources));
     }
-    stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold, summed: true }));
+    stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold }));
     // Explicit: u* = uⁿ + Δt ν L(uⁿ), then + Δt g. Implicit: uⁿ + Δt g first, then the
     // solve (the force inside it keeps the steady state exact).
     let nu = scene.fluid.viscosity / scene.fluid.density;

@@ -61,13 +61,15 @@ pub fn build_stages<K: Kernel, const D: usize>(
     };
     let walls = (!scene.boundaries.walls.is_empty()).then_some(scene.boundaries.wall_model);
     // Boundaries and neighbours at the current positions.
-    let boundaries = || {
+    // `div_r`: the neighbours stage also sums `div r` (for the shifting's free-surface flags).
+    let boundaries = |div_r: bool| {
         let mut v: Vec<Box<dyn Stage<D>>> = Vec::new();
         if walls == Some(WallModel::Mirror) {
             v.push(Box::new(walls::Walls::new(&scene.boundaries.walls, kernel.support)));
         }
         let rows = if walls == Some(WallModel::Dummy) { Rows::All } else { Rows::Fluid };
-        v.push(Box::new(Neighbours::new(kernel, domain, rows)));
+        let neighbours = Neighbours::new(kernel, domain, rows);
+        v.push(Box::new(if div_r { neighbours.summing_div_r() } else { neighbours }));
         if walls == Some(WallModel::Dummy) {
             v.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Start)));
         }
@@ -86,7 +88,8 @@ pub fn build_stages<K: Kernel, const D: usize>(
             )) as Box<dyn Stage<D>>
         })
     };
-    let mut prime = boundaries();
+    let mut prime = boundaries(false);
+    let shifting = Law::of(opts.shifting);
     prime.push(forces::momentum(params));
     prime.extend(tension());
     let mut stages: Vec<Box<dyn Stage<D>>> = vec![
@@ -94,7 +97,7 @@ pub fn build_stages<K: Kernel, const D: usize>(
         Box::new(integrator::Prime::new(eos, prime)),
         Box::new(integrator::KickDrift),
     ];
-    stages.extend(boundaries());
+    stages.extend(boundaries(shifting.is_some()));
     stages.push(forces::continuity(
         params,
         kernel,
@@ -106,10 +109,11 @@ pub fn build_stages<K: Kernel, const D: usize>(
     stages.push(forces::momentum(params));
     stages.extend(tension());
     stages.push(Box::new(integrator::Kick));
-    if let Some(law) = Law::of(opts.shifting) {
-        // The pairs are those of this step's positions (the kick moves no particle).
+    if let Some(law) = shifting {
+        // The pairs and `div r` are those of this step's positions (the kick moves no
+        // particle).
         let threshold = D as f64 - 0.5;
-        stages.push(Box::new(FreeSurface { threshold, summed: false }));
+        stages.push(Box::new(FreeSurface { threshold }));
         stages.push(Box::new(crate::isph::shifting::Shifting::new(law, kernel, threshold)));
     }
     stages
