@@ -300,7 +300,7 @@ impl PpeSolve {
                 let coarse = self.opts.preconditioner == PreconditionerKind::TwoLevel
                     && self.coarse.prepare(a, keys, singular);
                 if coarse {
-                    krylov_with(
+                    let iterations = krylov_with(
                         &self.opts,
                         a,
                         &self.coarse.preconditioner(&a.inv_diag),
@@ -308,7 +308,9 @@ impl PpeSolve {
                         p,
                         cg,
                         &mut self.workspace,
-                    )?
+                    )?;
+                    self.coarse.record(iterations);
+                    iterations
                 } else {
                     krylov_with(&self.opts, a, &Jacobi(&a.inv_diag), b, p, cg, &mut self.workspace)?
                 }
@@ -387,6 +389,7 @@ fn direct(a: &PpeMatrix, b: &[f64], x: &mut [f64], singular: bool) -> Result<(),
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::two_level::CoarseFactor;
 
     /// 5-point Laplacian on an m×m grid with Dirichlet boundary, as a PpeMatrix.
     fn grid(m: usize) -> PpeMatrix {
@@ -510,6 +513,83 @@ mod tests {
         let (_, rebuilt) = keyed_cg(&mut s, &a, &b, &new_keys, false);
         assert!(jacobi > 2 * fresh, "unknown keys: {jacobi} iterations against {fresh}");
         assert_eq!(rebuilt, fresh, "rebuilt on schedule");
+    }
+
+    /// A coarse space that has aged (here: every row's key unseen, so the coarse
+    /// correction is gone) is rebuilt at the next solve once a solve took more than
+    /// twice the iterations of the first solve after the last rebuild (plus 4), long
+    /// before the `coarse_refresh` schedule would.
+    #[test]
+    fn degraded_coarse_space_is_rebuilt_early() {
+        let a = strip(200, 8);
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
+        let keys: Vec<u32> = (0..n as u32).collect();
+        let new_keys: Vec<u32> = (n as u32..2 * n as u32).collect();
+        let mut s = two_level_cg(1000);
+        let (_, fresh) = keyed_cg(&mut s, &a, &b, &keys, false);
+        let (_, jacobi) = keyed_cg(&mut s, &a, &b, &new_keys, false);
+        let (_, rebuilt) = keyed_cg(&mut s, &a, &b, &new_keys, false);
+        assert!(jacobi > 2 * fresh + 4, "unknown keys: {jacobi} iterations against {fresh}");
+        assert_eq!(rebuilt, fresh, "rebuilt after the degraded solve");
+    }
+
+    /// The strip with one-way links in its first row of cells, as an open channel's inlet
+    /// buffer makes them (a buffer particle shares the unknown of the fluid particle
+    /// inside it: the rows next to it gain that unknown's column, whose row does not gain
+    /// theirs), keeping the rows' sums.
+    fn strip_with_inlet_links(rows: usize, m: usize) -> PpeMatrix {
+        let s = strip(rows, m);
+        let mut a = PpeMatrix { row_ptr: vec![0], ..Default::default() };
+        for k in 0..s.n() {
+            for (c, v) in s.row(k) {
+                a.push(c as usize, v);
+            }
+            if k < m {
+                a.push(k + 2 * m, -0.5);
+                a.push(k, 0.5);
+            }
+            a.end_row();
+        }
+        a
+    }
+
+    /// A non-symmetric system (the open channel's PPE) gets an LU coarse factor and the
+    /// two-level BiCGSTAB keeps its advantage over Jacobi; symmetric systems keep the
+    /// Cholesky factor.
+    #[test]
+    fn non_symmetric_system_gets_an_lu_coarse_factor() {
+        let solver = |preconditioner| {
+            PpeSolve::new(PpeOptions {
+                solver: PpeSolver::Bicgstab,
+                tolerance: 1e-10,
+                max_iterations: 20_000,
+                preconditioner,
+                coarse_refresh: 1,
+            })
+        };
+        let symmetric = strip(400, 8);
+        let a = strip_with_inlet_links(400, 8);
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
+        let mut p = vec![0.0; n];
+        let mut s = solver(PreconditionerKind::TwoLevel);
+        s.solve(&symmetric, &b, &mut p, false).expect("converges");
+        assert_eq!(s.coarse.factor_kind(), Some(CoarseFactor::Cholesky));
+        let mut pt = vec![0.0; n];
+        let two = s.solve(&a, &b, &mut pt, false).expect("converges").iterations;
+        assert_eq!(s.coarse.factor_kind(), Some(CoarseFactor::Lu));
+        let mut pd = vec![0.0; n];
+        direct(&a, &b, &mut pd, false).expect("LU solves");
+        let mut pj = vec![0.0; n];
+        let jacobi =
+            solver(PreconditionerKind::Jacobi).solve(&a, &b, &mut pj, false).expect("converges").iterations;
+        let scale = pd.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        for (name, x) in [("two-level", &pt), ("Jacobi", &pj)] {
+            let err = pd.iter().zip(x).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            assert!(err < 1e-7 * scale, "{name}: {err} vs {scale}");
+        }
+        assert!(3 * two < jacobi, "two-level {two} iterations, Jacobi {jacobi}");
     }
 
     /// A system with no Dirichlet row (the periodic channel's PPE) keeps its coarse

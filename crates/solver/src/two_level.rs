@@ -11,8 +11,13 @@
 //! Aggregates are built from the matrix graph (no geometry): rows are visited in order,
 //! and an unassigned row starts an aggregate with its unassigned neighbours, so an
 //! aggregate is about one kernel support of particles. `P` is piecewise constant on the
-//! aggregates; `A_c` is assembled column by column with a sparse accumulator and
-//! factorised by faer's sparse Cholesky (`A_c` is symmetric positive definite when `A` is).
+//! aggregates; `A_c` is assembled row by row with a sparse accumulator and factorised by
+//! faer's sparse Cholesky when it is symmetric (to rounding) and positive definite, which
+//! it is when `A` is (free-surface, closed and periodic systems, mirror walls), and by
+//! faer's sparse LU otherwise. The open channel's `A` is not symmetric (an inlet buffer
+//! particle shares the unknown of a fluid particle, a one-way link), and a Cholesky
+//! factor of the lower triangle of its `A_c` failed at 64 of 78 rebuilds (Re 400, D/36),
+//! leaving Jacobi: 47.6 BiCGSTAB iterations per step instead of 20 (measured, 2026-12-04).
 //!
 //! **The coarse space outlives a solve** ([`CoarseSpace`]): building it (aggregation,
 //! assembly, the symbolic and numeric factorisation) costs several Krylov iterations, and
@@ -21,12 +26,16 @@
 //! follow the particles, and the factor of the last rebuild serves the next `refresh`
 //! solves: particles move little relative to their neighbours in a step, so a factor a few
 //! steps old is still a good coarse solve (drop at Δx = 0.02, CG: 6.26 iterations per step
-//! with a rebuild every 25 solves against 6.20 with one every solve, measured). A row whose
+//! with a rebuild every 25 solves against 6.20 with one every solve, measured). Where it
+//! ages faster (the open channel, whose particles enter, leave and shear), a solve that
+//! takes over twice the iterations of the first one after the rebuild brings the next
+//! rebuild forward ([`CoarseSpace::record`]). A row whose
 //! key had no aggregate at the last rebuild (a particle that left the free surface, or came
-//! in through an inlet) gets the Jacobi part only until the next rebuild. The stale factor
-//! is still symmetric positive definite, so `M` is a fixed SPD operator between rebuilds
-//! and CG applies. Between rebuilds nothing is allocated; a rebuild allocates inside faer's
-//! symbolic factorisation (the coarse pattern is new), and reuses every buffer of its own.
+//! in through an inlet) gets the Jacobi part only until the next rebuild. A stale Cholesky
+//! factor is still symmetric positive definite, so `M` is a fixed SPD operator between
+//! rebuilds and CG applies (an LU factor serves BiCGSTAB, the solver for a non-symmetric
+//! `A`). Between rebuilds nothing is allocated; a rebuild allocates inside faer's symbolic
+//! factorisation (the coarse pattern is new), and reuses every buffer of its own.
 //!
 //! A system with no Dirichlet row (a closed or periodic domain) has the constant vector as
 //! its null space, and so has `A_c`: there the coarse unknown 0 is grounded (its row and
@@ -42,6 +51,7 @@ use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
     CholeskySymbolicParams, LltRef, SymbolicCholesky, SymmetricOrdering, factorize_symbolic_cholesky,
 };
+use faer::sparse::linalg::lu::{LuRef, NumericLu, SymbolicLu, factorize_symbolic_lu};
 use faer::sparse::{SparseColMatRef, SymbolicSparseColMatRef};
 use faer::{Conj, MatMut, Par, Side};
 use rayon::prelude::*;
@@ -54,11 +64,44 @@ const NONE: u32 = u32::MAX;
 /// (`scheme.isph.ppe.coarse_refresh`).
 pub const DEFAULT_REFRESH: usize = 25;
 
+/// Relative asymmetry `|a_gh − a_hg| / (|a_gg| + |a_hh|)` above which `A_c` is taken as
+/// non-symmetric: the rounding of the Galerkin sums of a symmetric `A` is ~1e-16, an inlet
+/// link is a whole pair coefficient (~1e-2).
+const ASYMMETRY: f64 = 1e-10;
+
+/// Whether a solve of `iterations` shows the kept coarse space has degraded against the
+/// `fresh` iterations of the first solve after its rebuild: more than 2 × fresh + 4.
+///
+/// Why: how fast a kept factor ages depends on the flow. On the elliptical drop a factor
+/// 25 solves old costs nothing (6.26 CG iterations per step against 6.20 rebuilding every
+/// solve; 6.26 with this rule, which its iteration spikes of 5 → 10 right after a rebuild
+/// do not trip, where a 1.5 × fresh + 2 rule did). In the open channel particles enter,
+/// leave and shear past each other, and two or three solves after a rebuild the
+/// iterations jump from ~12 to ~30: BiCGSTAB took 11.9 / 14.7 / 22.9 / 44.7 iterations per
+/// step with a rebuild every 1 / 2 / 5 / 25 solves, and 18.9 with this rule on the
+/// default 25 (Re 400, D/36, to 300 s; at Δx = 0.004 to 100 s 12.5 / 13.7 / 18.0 / 29.9
+/// and 20.2; measured 2026-12-05).
+fn degraded(iterations: usize, fresh: usize) -> bool {
+    iterations > 2 * fresh + 4
+}
+
+/// How the coarse matrix was factorised at the last rebuild.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CoarseFactor {
+    /// Sparse Cholesky (`A_c` symmetric positive definite).
+    Cholesky,
+    /// Sparse LU (`A_c` not symmetric, or not numerically positive definite).
+    Lu,
+}
+
 /// The factorised coarse matrix.
 #[derive(Debug)]
-struct Factor {
-    symbolic: SymbolicCholesky<usize>,
-    values: Vec<f64>,
+enum Factor {
+    /// `A_c = L Lᵀ`.
+    Cholesky { symbolic: SymbolicCholesky<usize>, values: Vec<f64> },
+    /// The LU factors of `A_cᵀ` (the rows of `A_c` read as compressed columns); the
+    /// coarse solve is its transposed solve.
+    Lu { symbolic: SymbolicLu<usize>, numeric: NumericLu<usize, f64> },
 }
 
 /// Scratch of one preconditioner application: the coarse vector and faer's workspace.
@@ -70,13 +113,17 @@ struct ApplyScratch {
 }
 
 /// The coarse space of the two-level preconditioner, kept across solves (see the module
-/// documentation): aggregates keyed by a stable key per row and the Cholesky factor of
-/// `A_c`, rebuilt every `refresh` solves.
+/// documentation): aggregates keyed by a stable key per row and the factor of `A_c`,
+/// rebuilt every `refresh` solves, or sooner when a solve shows it [`degraded`].
 #[derive(Debug)]
 pub struct CoarseSpace {
     refresh: usize,
     /// Solves since the last rebuild.
     age: usize,
+    /// Krylov iterations of the first solve after the last rebuild.
+    fresh_iterations: usize,
+    /// Whether a solve since the last rebuild took [`degraded`] iterations.
+    degraded: bool,
     /// Whether the last rebuild grounded coarse unknown 0 (a singular system).
     grounded: bool,
     /// Aggregate of each key at the last rebuild (`NONE`: none).
@@ -100,10 +147,15 @@ struct BuildScratch {
     acc: Vec<f64>,
     mark: Vec<u32>,
     touched: Vec<u32>,
-    /// `A_c` in compressed sparse columns, lower triangle.
-    col_ptr: Vec<usize>,
-    row_idx: Vec<usize>,
+    /// `A_c` in compressed sparse rows (columns sorted within a row).
+    row_ptr: Vec<usize>,
+    col_idx: Vec<usize>,
     values: Vec<f64>,
+    /// The lower triangle of a symmetric `A_c` in compressed sparse columns (column g is
+    /// row g's upper part).
+    lower_ptr: Vec<usize>,
+    lower_idx: Vec<usize>,
+    lower_values: Vec<f64>,
 }
 
 impl CoarseSpace {
@@ -112,6 +164,8 @@ impl CoarseSpace {
         Self {
             refresh: refresh.max(1),
             age: 0,
+            fresh_iterations: 0,
+            degraded: false,
             grounded: false,
             of_key: Vec::new(),
             of_row: Vec::new(),
@@ -127,16 +181,28 @@ impl CoarseSpace {
         self.nc
     }
 
+    /// How the last rebuild factorised `A_c` (`None`: it could not, Jacobi alone).
+    pub fn factor_kind(&self) -> Option<CoarseFactor> {
+        self.factor.as_ref().map(|f| match f {
+            Factor::Cholesky { .. } => CoarseFactor::Cholesky,
+            Factor::Lu { .. } => CoarseFactor::Lu,
+        })
+    }
+
     /// Readies the coarse space for a solve of `a`: rebuilds it when there is none yet (or
     /// the last one could not be factorised), when `refresh` solves have passed since the
-    /// last rebuild, when the system's kind (singular or not) changed, or when there are no
-    /// `keys` (then every solve rebuilds); otherwise maps the current
+    /// last rebuild, when a solve since then showed it [`degraded`], when the system's
+    /// kind (singular or not) changed, or when there are no `keys` (then every solve
+    /// rebuilds); otherwise maps the current
     /// rows to the kept aggregates through `keys` (one per row). Returns whether a coarse
-    /// correction is available (a coarse matrix that is not positive definite leaves
-    /// Jacobi alone).
+    /// correction is available (a coarse matrix that faer cannot factorise leaves Jacobi
+    /// alone).
     pub fn prepare(&mut self, a: &PpeMatrix, keys: Option<&[u32]>, singular: bool) -> bool {
-        let stale =
-            keys.is_none() || self.factor.is_none() || self.age >= self.refresh || self.grounded != singular;
+        let stale = keys.is_none()
+            || self.factor.is_none()
+            || self.age >= self.refresh
+            || self.degraded
+            || self.grounded != singular;
         match keys {
             Some(keys) if !stale => {
                 debug_assert_eq!(keys.len(), a.n());
@@ -155,10 +221,22 @@ impl CoarseSpace {
                     }
                 }
                 self.age = 0;
+                self.degraded = false;
             }
         }
         self.age += 1;
         self.factor.is_some()
+    }
+
+    /// Records the Krylov iterations of the solve just preconditioned: the first solve
+    /// after a rebuild sets the reference, and a later one that took [`degraded`]
+    /// iterations schedules a rebuild for the next solve.
+    pub fn record(&mut self, iterations: usize) {
+        if self.age == 1 {
+            self.fresh_iterations = iterations;
+        } else if degraded(iterations, self.fresh_iterations) {
+            self.degraded = true;
+        }
     }
 
     /// The preconditioner `D⁻¹ + P A_c⁻¹ Pᵀ` for the current rows, `inv_diag` being
@@ -212,27 +290,28 @@ impl CoarseSpace {
             members[*slot as usize] = i as u32;
             *slot += 1;
         }
-        // A_c column by column (A_c is symmetric: column g is row g), lower triangle, rows
-        // sorted; a grounded unknown 0 keeps only its unit diagonal.
+        // A_c row by row (row g sums the rows of aggregate g, column h the entries in
+        // aggregate h's columns), columns sorted; a grounded unknown 0 keeps only its unit
+        // diagonal, in its row and its column.
         b.acc.clear();
         b.acc.resize(nc, 0.0);
         b.mark.clear();
         b.mark.resize(nc, NONE);
-        b.col_ptr.clear();
-        b.row_idx.clear();
+        b.row_ptr.clear();
+        b.col_idx.clear();
         b.values.clear();
-        b.col_ptr.push(0);
+        b.row_ptr.push(0);
         for g in 0..nc {
             if singular && g == 0 {
-                b.row_idx.push(0);
+                b.col_idx.push(0);
                 b.values.push(1.0);
-                b.col_ptr.push(b.row_idx.len());
+                b.row_ptr.push(b.col_idx.len());
                 continue;
             }
             for &i in &b.members[b.start[g]..b.start[g + 1]] {
                 for (j, v) in a.row(i as usize) {
                     let h = of_row[j as usize];
-                    if (h as usize) < g || (singular && h == 0) {
+                    if singular && h == 0 {
                         continue;
                     }
                     if b.mark[h as usize] != g as u32 {
@@ -244,30 +323,86 @@ impl CoarseSpace {
             }
             b.touched.sort_unstable();
             for &h in &b.touched {
-                b.row_idx.push(h as usize);
+                b.col_idx.push(h as usize);
                 b.values.push(b.acc[h as usize]);
                 b.acc[h as usize] = 0.0;
             }
             b.touched.clear();
-            b.col_ptr.push(b.row_idx.len());
+            b.row_ptr.push(b.col_idx.len());
         }
-        let reuse = self.factor.take().map(|f| f.values).unwrap_or_default();
-        self.factor = factorise(nc, b, reuse, &self.scratch);
+        let values = match self.factor.take() {
+            Some(Factor::Cholesky { values, .. }) => values,
+            _ => Vec::new(),
+        };
+        let cholesky = if symmetric(nc, b) { cholesky(nc, b, values, &self.scratch) } else { None };
+        self.factor = cholesky.or_else(|| lu(nc, b, &self.scratch));
+        if self.factor.is_some() {
+            let mut s = self.scratch.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+            s.coarse.resize(nc, 0.0);
+        }
     }
 }
 
-/// The Cholesky factor of the lower triangle of `A_c` in `b` (compressed sparse columns),
-/// its values stored in `values` (a buffer reused across rebuilds); `None` when faer
-/// rejects the pattern or the matrix is not numerically positive definite. Sizes the
-/// application scratch for the factor.
-fn factorise(
+/// Whether `A_c` (compressed rows in `b`) is symmetric to rounding: every `a_gh` has an
+/// `a_hg` within `ASYMMETRY (|a_gg| + |a_hh|)`. Copies the upper part of each row into
+/// `b`'s lower-triangle arrays (column g of the lower triangle), which the Cholesky
+/// factorisation reads.
+fn symmetric(nc: usize, b: &mut BuildScratch) -> bool {
+    let BuildScratch { row_ptr, col_idx, values, lower_ptr, lower_idx, lower_values, .. } = b;
+    let entry = |g: usize, h: usize| {
+        let (s, e) = (row_ptr[g], row_ptr[g + 1]);
+        col_idx[s..e].binary_search(&h).ok().map(|k| values[s + k])
+    };
+    lower_ptr.clear();
+    lower_idx.clear();
+    lower_values.clear();
+    lower_ptr.push(0);
+    for g in 0..nc {
+        let a_gg = entry(g, g).unwrap_or(0.0).abs();
+        for k in row_ptr[g]..row_ptr[g + 1] {
+            let (h, v) = (col_idx[k], values[k]);
+            if h < g {
+                continue;
+            }
+            if h > g {
+                let a_hh = entry(h, h).unwrap_or(0.0).abs();
+                let tol = ASYMMETRY * (a_gg + a_hh);
+                if entry(h, g).is_none_or(|w| (w - v).abs() > tol) {
+                    return false;
+                }
+            }
+            lower_idx.push(h);
+            lower_values.push(v);
+        }
+        lower_ptr.push(lower_idx.len());
+    }
+    true
+}
+
+/// faer's workspace in `slot`, grown to at least `req`.
+fn workspace(slot: &mut Option<(MemBuffer, StackReq)>, req: StackReq) -> &mut MemBuffer {
+    let fits = slot.as_ref().is_some_and(|(_, have)| {
+        have.size_bytes() >= req.size_bytes() && have.align_bytes() >= req.align_bytes()
+    });
+    if !fits {
+        let grown = slot.as_ref().map_or(req, |(_, have)| have.or(req));
+        *slot = Some((MemBuffer::new(grown), grown));
+    }
+    &mut slot.as_mut().expect("sized above").0
+}
+
+/// The Cholesky factor of the lower triangle of `A_c` (`b`'s lower-triangle arrays), its
+/// values stored in `values` (a buffer reused across rebuilds); `None` when faer rejects
+/// the pattern or the matrix is not numerically positive definite. Sizes the application
+/// workspace for the factor.
+fn cholesky(
     nc: usize,
     b: &BuildScratch,
     mut values: Vec<f64>,
     scratch: &Mutex<ApplyScratch>,
 ) -> Option<Factor> {
-    let pattern = SymbolicSparseColMatRef::new_checked(nc, nc, &b.col_ptr, None, &b.row_idx);
-    let lower = SparseColMatRef::new(pattern, &b.values);
+    let pattern = SymbolicSparseColMatRef::new_checked(nc, nc, &b.lower_ptr, None, &b.lower_idx);
+    let lower = SparseColMatRef::new(pattern, &b.lower_values);
     let symbolic = factorize_symbolic_cholesky(
         pattern,
         Side::Lower,
@@ -282,18 +417,6 @@ fn factorise(
         symbolic.solve_in_place_scratch::<f64>(1, Par::Seq),
     ]);
     let mut s = scratch.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-    let (mem, _) = match &mut s.mem {
-        Some((m, have))
-            if have.size_bytes() >= req.size_bytes() && have.align_bytes() >= req.align_bytes() =>
-        {
-            (m, *have)
-        }
-        slot => {
-            let grown = slot.as_ref().map_or(req, |(_, have)| have.or(req));
-            let (m, have) = slot.insert((MemBuffer::new(grown), grown));
-            (m, *have)
-        }
-    };
     symbolic
         .factorize_numeric_llt(
             &mut values,
@@ -301,12 +424,40 @@ fn factorise(
             Side::Lower,
             LltRegularization::default(),
             Par::Seq,
-            MemStack::new(mem),
+            MemStack::new(workspace(&mut s.mem, req)),
             Default::default(),
         )
         .ok()?;
-    s.coarse.resize(nc, 0.0);
-    Some(Factor { symbolic, values })
+    Some(Factor::Cholesky { symbolic, values })
+}
+
+/// The LU factors of `A_cᵀ` (`b`'s compressed rows of `A_c` read as compressed columns);
+/// `None` when faer rejects the pattern or the matrix is singular. Sizes the application
+/// workspace for the factor.
+///
+/// The numeric factors are allocated afresh: faer 0.24's simplicial LU, refactorising
+/// into the storage of a larger matrix's factors, kept the old column pointers and
+/// panicked in the solve (found here, coarse sizes 1878 then 1809).
+fn lu(nc: usize, b: &BuildScratch, scratch: &Mutex<ApplyScratch>) -> Option<Factor> {
+    let mut numeric = NumericLu::new();
+    let pattern = SymbolicSparseColMatRef::new_checked(nc, nc, &b.row_ptr, None, &b.col_idx);
+    let transposed = SparseColMatRef::new(pattern, &b.values);
+    let symbolic = factorize_symbolic_lu(pattern, Default::default()).ok()?;
+    let req = StackReq::any_of(&[
+        symbolic.factorize_numeric_lu_scratch::<f64>(Par::Seq, Default::default()),
+        symbolic.solve_transpose_in_place_scratch::<f64>(1, Par::Seq),
+    ]);
+    let mut s = scratch.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    symbolic
+        .factorize_numeric_lu(
+            &mut numeric,
+            transposed,
+            Par::Seq,
+            MemStack::new(workspace(&mut s.mem, req)),
+            Default::default(),
+        )
+        .ok()?;
+    Some(Factor::Lu { symbolic, numeric })
 }
 
 impl std::fmt::Debug for ApplyScratch {
@@ -347,12 +498,14 @@ impl Preconditioner for TwoLevel<'_> {
         }
         let (mem, _) = mem.as_mut().expect("sized with the factor");
         let rhs = MatMut::from_column_major_slice_mut(coarse.as_mut_slice(), space.nc, 1);
-        LltRef::new(&factor.symbolic, &factor.values).solve_in_place_with_conj(
-            Conj::No,
-            rhs,
-            Par::Seq,
-            MemStack::new(mem),
-        );
+        let stack = MemStack::new(mem);
+        match factor {
+            Factor::Cholesky { symbolic, values } => {
+                LltRef::new(symbolic, values).solve_in_place_with_conj(Conj::No, rhs, Par::Seq, stack)
+            }
+            Factor::Lu { symbolic, numeric } => LuRef::new_unchecked(symbolic, numeric)
+                .solve_transpose_in_place_with_conj(Conj::No, rhs, Par::Seq, stack),
+        }
         let coarse = &*coarse;
         z.par_iter_mut().zip(r).zip(self.inv_diag).zip(&space.of_row).with_min_len(1024).for_each(
             |(((zi, ri), di), &g)| {
