@@ -531,9 +531,10 @@ pub struct PpeOptions {
     /// Preconditioner of the Krylov solvers (default Jacobi).
     #[serde(default)]
     pub preconditioner: Preconditioner,
-    /// Solves between rebuilds of the two-level preconditioner's coarse space (aggregates
-    /// and factorised coarse matrix, kept across steps: `two_level.rs`); default 25, at
-    /// least 1. Unused with Jacobi.
+    /// Most solves between rebuilds of the two-level preconditioner's coarse space
+    /// (aggregates and factorised coarse matrix, kept across steps: `two_level.rs`; a
+    /// solve that shows it degraded brings the rebuild forward); default 25, at least 1.
+    /// Unused with Jacobi.
     #[serde(default = "default_coarse_refresh")]
     pub coarse_refresh: usize,
 }
