@@ -123,7 +123,7 @@ pub(crate) mod tests {
                 steps: 2,
                 t_end: 1.0,
                 wall_s: 0.5,
-                status: "ok".into(),
+                status: meniscus::Status::Ok,
                 error: None,
                 stages: BTreeMap::new(),
                 threads: 1,

@@ -191,7 +191,7 @@ fn run_specs(
 
 /// The run's status string (DESIGN.md): `ok` or `diverged: <cause at step/time>`.
 fn status(r: &RunRecord) -> String {
-    if r.summary.status == "ok" && r.summary.error.is_none() {
+    if r.summary.status == meniscus::Status::Ok && r.summary.error.is_none() {
         "ok".to_string()
     } else {
         format!("diverged: {}", r.summary.error.as_deref().unwrap_or("unknown cause"))
@@ -356,7 +356,7 @@ mod tests {
     #[test]
     fn diverged_run_fails_its_checks() {
         let mut bad = synthetic("paper", 0.02, 5.0, 7860);
-        bad.summary.status = "diverged".into();
+        bad.summary.status = meniscus::Status::Diverged;
         bad.summary.error = Some("diverged in stage `ppe` at step 7".into());
         let recs = vec![synthetic("paper", 0.04, 5.0, 1976), bad];
         let res = assemble(&drop_case(), Tier::Quick, &recs).unwrap();

@@ -29,5 +29,5 @@ pub mod wcsph;
 
 pub use error::{Cause, SceneError, SolverError};
 pub use probes::ProbeRecord;
-pub use run::{AnySimulation, Frame, Observer, Quiet, RunReport, Summary, run};
+pub use run::{AnySimulation, Frame, Observer, Quiet, RunReport, Status, Summary, run};
 pub use scene::Scene;

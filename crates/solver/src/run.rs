@@ -27,8 +27,8 @@ pub struct Summary {
     pub t_end: f64,
     /// Wall time of the stepping loop \[s\].
     pub wall_s: f64,
-    /// `ok` or `diverged`.
-    pub status: String,
+    /// How the run ended (`"ok"` or `"diverged"` in the JSON).
+    pub status: Status,
     /// The divergence message, when diverged.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
@@ -38,6 +38,16 @@ pub struct Summary {
     pub threads: usize,
     /// Mean PPE iterations per step.
     pub ppe_iterations_mean: f64,
+}
+
+/// How a run ended (`summary.json`'s `status`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Status {
+    /// The run reached its end time.
+    Ok,
+    /// A stage or guard failed; [`Summary::error`] says where and why.
+    Diverged,
 }
 
 /// A particle snapshot in initial-id order, for VTK frames, final-state metrics and the
@@ -460,7 +470,7 @@ impl<const D: usize> Simulation<D> {
             steps: step,
             t_end: t,
             wall_s,
-            status: if error.is_some() { "diverged".into() } else { "ok".into() },
+            status: if error.is_some() { Status::Diverged } else { Status::Ok },
             error: error.as_ref().map(|e| e.to_string()),
             stages,
             threads,

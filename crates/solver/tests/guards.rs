@@ -14,7 +14,7 @@ fn a_time_step_far_beyond_the_cfl_limit_diverges_with_a_named_cause() {
     });
     let report = meniscus::run(&scene, &mut meniscus::Quiet).expect("scene builds");
     let err = report.error.as_ref().expect("the run must diverge");
-    assert_eq!(report.summary.status, "diverged");
+    assert_eq!(report.summary.status, meniscus::Status::Diverged);
     assert!(report.summary.error.as_deref().is_some_and(|m| m.contains("step")));
     assert!(err.step >= 1 && err.time < 0.1);
     assert!(
@@ -130,7 +130,7 @@ fn an_adaptive_step_below_its_floor_is_a_typed_error_at_the_first_step() {
     assert_eq!((err.stage, err.step, err.time), ("time_step", 1, 0.0));
     let Cause::DtFloor { dt, floor } = err.cause else { panic!("{err}") };
     assert!(dt < floor && (floor - 1e-9).abs() < 1e-24, "{err}");
-    assert_eq!(report.summary.status, "diverged");
+    assert_eq!(report.summary.status, meniscus::Status::Diverged);
     assert_eq!(report.summary.steps, 0);
     let msg = err.to_string();
     assert!(msg.contains("time_step") && msg.contains("floor"), "{msg}");

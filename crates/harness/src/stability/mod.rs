@@ -506,7 +506,7 @@ impl Runner<'_> {
             }
             _ => measured.series.get("u_profile_l2_rel").and_then(|s| s.last().copied()).unwrap_or(f64::NAN),
         };
-        let ok = r.summary.status == "ok" && r.summary.error.is_none();
+        let ok = r.summary.status == meniscus::Status::Ok && r.summary.error.is_none();
         let status = if ok {
             "ok".to_string()
         } else {
