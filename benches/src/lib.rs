@@ -158,7 +158,7 @@ impl StageBench {
 
     /// PPE iterations of the last run of the stage (meaningful for `ppe_solve`).
     pub fn ppe_iterations(&self) -> usize {
-        self.stepper.state().ppe.info.iterations
+        self.stepper.state().solve.iterations
     }
 
     /// Runs the stage `iters` times and returns the time spent in the stage alone (the

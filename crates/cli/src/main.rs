@@ -59,6 +59,10 @@ enum Command {
         /// Worker threads (default: all cores).
         #[arg(long)]
         threads: Option<usize>,
+        /// Stop after N steps if the end time is not reached before (a truncated run: the
+        /// outputs cover the steps taken; summary.json's t_end is the time reached).
+        #[arg(long)]
+        max_steps: Option<usize>,
     },
     /// Validate a scene file and print what a run would build.
     Check {
@@ -73,7 +77,9 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match &cli.command {
-        Command::Run { scene, out, vtk_every, threads } => run::run(scene, out, *vtk_every, *threads),
+        Command::Run { scene, out, vtk_every, threads, max_steps } => {
+            run::run(scene, out, *vtk_every, *threads, *max_steps)
+        }
         Command::Check { scene } => run::check(scene),
         Command::Reference(cmd) => reference::run(cmd),
     };

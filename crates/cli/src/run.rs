@@ -46,6 +46,7 @@ pub fn run(
     out: &Path,
     vtk_every: Option<usize>,
     threads: Option<usize>,
+    max_steps: Option<usize>,
 ) -> anyhow::Result<()> {
     let mut scene = Scene::from_path(scene_path)?;
     if let Some(n) = vtk_every {
@@ -63,6 +64,9 @@ pub fn run(
         writable_dir(dir)?;
     }
     let mut sim = AnySimulation::new(&scene)?;
+    if let Some(n) = max_steps {
+        sim.stop_after(n);
+    }
     let bar = ProgressBar::new(1000);
     bar.set_style(
         ProgressStyle::with_template("{prefix} [{bar:40}] {percent:>3}% {elapsed_precise} {msg}")

@@ -83,6 +83,7 @@ mod tests {
             u: vec![[0.0; 3]; 2],
             p: vec![-5.0, 7.5],
             free_surface: vec![false, true],
+            ..Default::default()
         };
         let file = SnapshotFile {
             slug: "isph-shifting_dx0.02".into(),

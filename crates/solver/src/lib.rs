@@ -5,29 +5,37 @@
 //! compressible SPH ([`wcsph`]), dimension-generic
 //! (`const D: usize`) over `nalgebra::SVector<f64, D>`.
 //!
-//! A [`scene::Scene`] (JSON) describes a run; [`run::AnySimulation`] builds the particles
-//! and the step's stage list from it (a stage the scene does not need is not built) and
-//! steps it to the end time, returning a [`run::RunReport`] with `summary.json` and
-//! `probes.json` content. Units are SI throughout.
+//! A [`scene::Scene`] (JSON) describes a run; [`run::AnySimulation`] builds it through its
+//! scheme ([`scheme::Scheme`]: the particles, the scheme's own data and the step's stage
+//! list, a stage the scene does not need not built; [`registry`] maps the scene's scheme
+//! to its implementation) and steps it to the end time, returning a [`run::RunReport`]
+//! with `summary.json` and `probes.json` content. Units are SI throughout.
 
 pub mod error;
+pub mod fields;
+pub mod frame;
+pub mod guard;
 pub mod isph;
 pub mod kernel;
-pub mod krylov;
+pub mod linalg;
 pub mod neighbours;
-pub mod ppe;
+pub mod operators;
 pub mod probes;
 pub mod profile;
+pub mod registry;
 pub mod run;
 pub mod scene;
+pub mod scheme;
+pub mod setup;
 pub mod stage;
 pub mod stages;
 pub mod state;
-pub mod two_level;
+pub mod time_step;
 pub mod warm_pool;
 pub mod wcsph;
 
 pub use error::{Cause, SceneError, SolverError};
 pub use probes::ProbeRecord;
-pub use run::{AnySimulation, Frame, Observer, Quiet, RunReport, Status, Summary, run};
+pub use frame::Frame;
+pub use run::{AnySimulation, Observer, Quiet, RunReport, Status, Summary, run};
 pub use scene::Scene;

@@ -22,10 +22,12 @@
 //! whole step, which rebuilds the lists from the restored positions.
 
 use crate::error::{SceneError, SolverError};
+use crate::fields::Extent;
 use crate::run::Simulation;
 use crate::scene::Scene;
+use crate::scheme::SavedState;
 use crate::stage::StepContext;
-use crate::state::{Flux, InletLink, Particles, State, Vector, WcFields};
+use crate::state::State;
 
 /// A simulation with its clock, steppable one stage at a time.
 #[derive(Debug)]
@@ -33,21 +35,16 @@ pub struct Stepper<const D: usize> {
     sim: Simulation<D>,
     time: f64,
     step: usize,
+    /// Stage and guard seconds of [`Stepper::step_once`] (not reported; the step function
+    /// is the driver's, which times them).
+    timings: Vec<f64>,
 }
 
-/// The per-particle arrays (with the open-boundary buffers, the inlet link, the mass fluxes
-/// and the WCSPH fields) and the clock of a [`Stepper`] at one instant.
+/// The declared per-particle fields (with the open-boundary bookkeeping) and the clock of
+/// a [`Stepper`] at one instant.
 #[derive(Debug, Clone, Default)]
 pub struct Snapshot<const D: usize> {
-    particles: Particles<D>,
-    x_old: Vec<Vector<D>>,
-    u_old: Vec<Vector<D>>,
-    div_r: Vec<f64>,
-    free_surface: Vec<bool>,
-    buffer: usize,
-    flux: Flux,
-    inlet: InletLink,
-    wc: WcFields<D>,
+    saved: SavedState<D>,
     time: f64,
     step: usize,
 }
@@ -63,12 +60,23 @@ impl<const D: usize> Stepper<D> {
                 format!("must be {D} for this stepper"),
             ));
         }
-        Ok(Self { sim: Simulation::new(scene)?, time: 0.0, step: 0 })
+        Ok(Self::of(Simulation::new(scene)?))
+    }
+
+    /// A stepper of a built simulation at t = 0.
+    pub fn of(sim: Simulation<D>) -> Self {
+        let timings = vec![0.0; sim.method().stage_count() + 1];
+        Self { sim, time: 0.0, step: 0, timings }
     }
 
     /// The current state.
     pub fn state(&self) -> &State<D> {
-        &self.sim.state
+        self.sim.state()
+    }
+
+    /// The simulation.
+    pub fn simulation(&self) -> &Simulation<D> {
+        &self.sim
     }
 
     /// Time reached \[s\].
@@ -83,17 +91,17 @@ impl<const D: usize> Stepper<D> {
 
     /// Number of stages of one step.
     pub fn stage_count(&self) -> usize {
-        self.sim.stages.len()
+        self.sim.method().stage_count()
     }
 
     /// Name of stage `i` (as in `summary.json`); panics if `i >= stage_count()`.
     pub fn stage_name(&self, i: usize) -> &'static str {
-        self.sim.stages[i].name()
+        self.sim.method().stage_name(i)
     }
 
     /// Index of the first stage called `name`, if the scene built one.
     pub fn stage_index(&self, name: &str) -> Option<usize> {
-        self.sim.stages.iter().position(|s| s.name() == name)
+        (0..self.stage_count()).find(|&i| self.stage_name(i) == name)
     }
 
     /// The context of the next step: its number, the current time and Δt from the scene's
@@ -110,13 +118,8 @@ impl<const D: usize> Stepper<D> {
 
     /// Runs stage `i` of the step described by `ctx`; panics if `i >= stage_count()`.
     pub fn run_stage(&mut self, i: usize, ctx: &StepContext) -> Result<(), SolverError> {
-        let stage = &mut self.sim.stages[i];
-        stage.run(&mut self.sim.state, ctx).map_err(|cause| SolverError {
-            stage: stage.name(),
-            step: ctx.step,
-            time: ctx.time,
-            cause,
-        })
+        let m = self.sim.method_mut();
+        m.run_stage(i, ctx).map_err(|cause| SolverError { stage: m.stage_name(i), step: ctx.step, time: ctx.time, cause })
     }
 
     /// Runs stages `0..end` of the step described by `ctx` (prepares the input of stage
@@ -135,54 +138,37 @@ impl<const D: usize> Stepper<D> {
         })
     }
 
-    /// One whole step as the driver takes it (time step, every stage, guard) and advances
-    /// the clock; returns Δt.
+    /// One whole step as the driver takes it (its step function: every stage, then the
+    /// guard) and advances the clock; returns Δt.
     pub fn step_once(&mut self) -> Result<f64, SolverError> {
         let ctx = self.begin_step()?;
-        self.run_stages_before(self.stage_count(), &ctx)?;
-        self.guard(&ctx)?;
+        self.sim.advance(&ctx, &mut self.timings)?;
         self.step += 1;
         self.time += ctx.dt;
         Ok(ctx.dt)
     }
 
-    /// Copies the per-particle arrays and the clock.
+    /// Copies the declared per-particle fields and the clock.
     pub fn snapshot(&self) -> Snapshot<D> {
         let mut s = Snapshot::default();
         self.snapshot_into(&mut s);
         s
     }
 
-    /// Copies the per-particle arrays and the clock into `snap`, reusing its storage.
+    /// Copies the declared per-particle fields and the clock into `snap`, reusing its
+    /// storage.
     pub fn snapshot_into(&self, snap: &mut Snapshot<D>) {
-        let st = &self.sim.state;
-        snap.particles.clone_from(&st.particles);
-        snap.x_old.clone_from(&st.x_old);
-        snap.u_old.clone_from(&st.u_old);
-        snap.div_r.clone_from(&st.div_r);
-        snap.free_surface.clone_from(&st.free_surface);
-        snap.buffer = st.buffer;
-        snap.flux = st.flux;
-        snap.inlet.clone_from(&st.inlet);
-        snap.wc.clone_from(&st.wc);
+        self.sim.method().save(&mut snap.saved, Extent::All);
         snap.time = self.time;
         snap.step = self.step;
     }
 
-    /// Puts back the per-particle arrays and the clock of `snap` (taken from this stepper;
-    /// see the module documentation for when that is consistent). The neighbour lists, the
-    /// pair cache and the PPE system are left as they are.
+    /// Puts back the declared per-particle fields and the clock of `snap` (taken from this
+    /// stepper; see the module documentation for when that is consistent). The neighbour
+    /// lists, the pair cache and the scheme's per-step data (the PPE system) are left as
+    /// they are.
     pub fn restore(&mut self, snap: &Snapshot<D>) {
-        let st = &mut self.sim.state;
-        st.particles.clone_from(&snap.particles);
-        st.x_old.clone_from(&snap.x_old);
-        st.u_old.clone_from(&snap.u_old);
-        st.div_r.clone_from(&snap.div_r);
-        st.free_surface.clone_from(&snap.free_surface);
-        st.buffer = snap.buffer;
-        st.flux = snap.flux;
-        st.inlet.clone_from(&snap.inlet);
-        st.wc.clone_from(&snap.wc);
+        self.sim.method_mut().restore(&snap.saved);
         self.time = snap.time;
         self.step = snap.step;
     }
@@ -237,15 +223,15 @@ mod tests {
         st.run_stages_before(solve, &ctx).unwrap();
         let snap = st.snapshot();
         st.run_stage(solve, &ctx).unwrap();
-        let first = st.state().ppe.info;
+        let first = st.state().solve;
         let p_first = st.state().particles.p.clone();
         assert!(first.iterations > 0);
         // Without a restore the warm start is the solution: no work left.
         st.run_stage(solve, &ctx).unwrap();
-        assert!(st.state().ppe.info.iterations < first.iterations);
+        assert!(st.state().solve.iterations < first.iterations);
         st.restore(&snap);
         st.run_stage(solve, &ctx).unwrap();
-        assert_eq!(st.state().ppe.info.iterations, first.iterations);
+        assert_eq!(st.state().solve.iterations, first.iterations);
         assert_eq!(st.state().particles.p, p_first);
         // A whole step from a restored state is the same step again.
         st.restore(&snap);

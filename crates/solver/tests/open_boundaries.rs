@@ -105,12 +105,13 @@ fn the_relaxation_density_is_one_on_the_walled_lattice() {
     let ctx = st.begin_step().expect("time step");
     st.run_stages_before(stage + 1, &ctx).expect("runs");
     let s = st.state();
+    let own = st.simulation().method().own().downcast_ref::<meniscus::isph::IsphData>().expect("an ISPH run");
     let dx = D / rows as f64;
     let interior =
         (0..s.particles.fluid).filter(|&a| (4.0 * dx..2.0 * D - 4.0 * dx).contains(&s.particles.x[a][0]));
     let mut checked = 0;
     for a in interior {
-        let d = s.particle_density[a];
+        let d = own.particle_density[a];
         assert!((d - 1.0).abs() < 1e-12, "particle {a} at {:?}: {d}", s.particles.x[a]);
         checked += 1;
     }

@@ -88,7 +88,9 @@ fn assembled_matrix_is_symmetric_with_zero_interior_row_sums() {
         let ctx = stepper.begin_step().expect("a time step");
         stepper.run_stages_before(assemble + 1, &ctx).expect("stages run");
         let st = stepper.state();
-        let (a, sys) = (&st.ppe.matrix, &st.ppe);
+        let own = stepper.simulation().method().own();
+        let sys = &own.downcast_ref::<meniscus::isph::IsphData>().expect("an ISPH run").ppe;
+        let a = &sys.matrix;
         let entry = |i: usize, j: u32| -> f64 { a.row(i).filter(|&(c, _)| c == j).map(|(_, v)| v).sum() };
         let (mut checked, mut interior) = (0, 0);
         for i in 0..a.n() {

@@ -200,7 +200,7 @@ fn corner_particles_are_mirrored_twice() {
         }
         assert_eq!(sign, if n == 1 { -1.0 } else { 1.0 });
         // Velocities at the start of the step: the mirror's is exactly sign × its source's.
-        assert_eq!(s.u_old[nf + k], s.u_old[src as usize] * sign);
+        assert_eq!(s.particles.u_old[nf + k], s.particles.u_old[src as usize] * sign);
         if n == 1 { singles += 1 } else { doubles += 1 }
     }
     // Three rows/columns within the support of each wall; 3 × 3 in the corner.

@@ -43,7 +43,7 @@ fn surface_pressure_of_a_relaxed_circle_is_sigma_over_r() {
     st.run_stages_before(i + 1, &ctx).expect("runs");
     let s = st.state();
     let p: Vec<f64> =
-        (0..s.particles.fluid).filter(|&a| s.free_surface[a]).map(|a| s.particles.p[a]).collect();
+        (0..s.particles.fluid).filter(|&a| s.particles.free_surface[a]).map(|a| s.particles.p[a]).collect();
     assert!(p.len() > 50, "{} surface particles", p.len());
     let mean = p.iter().sum::<f64>() / p.len() as f64;
     assert!((mean - 5.0).abs() < 0.15, "mean σκ {mean} Pa");

@@ -29,6 +29,7 @@
 //! the Shao–Lo value is used. Not symmetric: linear momentum is not conserved exactly.
 
 use crate::error::Cause;
+use crate::operators::ShaoLo;
 use crate::stage::{Stage, StepContext};
 use crate::state::{State, Vector};
 use nalgebra::{SMatrix, SVector};
@@ -61,7 +62,7 @@ fn laplacian<const D: usize, const N: usize>(
     pairs: &[crate::state::Pair<D>],
     nbrs: &[u32],
     u: &[Vector<D>],
-    eta2: f64,
+    op: ShaoLo,
     volume: f64,
 ) -> Vector<D> {
     let sym = sym_pairs::<D, N>();
@@ -77,7 +78,7 @@ fn laplacian<const D: usize, const N: usize>(
     let mut shao_lo = Vector::<D>::zeros();
     for (p, &b) in pairs.iter().zip(nbrs) {
         let r = p.r_ab;
-        let fq = p.f / (p.r2() + eta2);
+        let fq = p.f / op.denominator(p);
         let du = u[a] - u[b as usize];
         let s = SVector::<f64, N>::from_fn(|k, _| r[sym[k].0] * r[sym[k].1]);
         let s_prime = SVector::<f64, N>::from_fn(|k, _| if sym[k].0 == sym[k].1 { s[k] } else { 2.0 * s[k] });
@@ -113,23 +114,23 @@ pub struct ConsistentViscosity {
     pub nu: f64,
 }
 
-impl<const D: usize> Stage<D> for ConsistentViscosity {
+impl<const D: usize, O> Stage<D, O> for ConsistentViscosity {
     fn name(&self) -> &'static str {
         "viscosity"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
-        let eta2 = 0.01 * s.h * s.h;
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
+        let shao_lo = ShaoLo::new(s.h);
         let c = ctx.dt * self.nu;
-        let (list, pairs, u_old, volume) = (&s.neighbours, &s.pairs, &s.u_old, s.volume);
+        let (list, pairs, u_old, volume) = (&s.neighbours, &s.pairs, &s.particles.u_old, s.volume);
         s.particles.u[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(128).for_each(|(a, u)| {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let (pairs, nbrs) = (&pairs[lo..hi], &list.indices[lo..hi]);
             // Scenes are 2D or 3D (scene validation): N = 3 or 6.
             let lap = if D == 2 {
-                laplacian::<D, 3>(a, pairs, nbrs, u_old, eta2, volume)
+                laplacian::<D, 3>(a, pairs, nbrs, u_old, shao_lo, volume)
             } else {
-                laplacian::<D, 6>(a, pairs, nbrs, u_old, eta2, volume)
+                laplacian::<D, 6>(a, pairs, nbrs, u_old, shao_lo, volume)
             };
             *u = u_old[a] + lap * c;
         });
@@ -180,7 +181,7 @@ mod tests {
         let phi = |x: f64, y: f64| 0.3 + 2.0 * x - y + x * x + 3.0 * x * y - 2.0 * y * y;
         for jitter in [0.0, 0.3, 0.6] {
             let (pairs, nbrs, u, v) = stencil(phi, jitter);
-            let lap = laplacian::<2, 3>(0, &pairs, &nbrs, &u, 0.01 * 0.0225, v);
+            let lap = laplacian::<2, 3>(0, &pairs, &nbrs, &u, ShaoLo::new(0.15), v);
             // ∇²φ = 2 − 4 = −2; the second component is 2φ.
             assert!((lap[0] + 2.0).abs() < 1e-9, "jitter {jitter}: {}", lap[0]);
             assert!((lap[1] + 4.0).abs() < 1e-9, "jitter {jitter}: {}", lap[1]);
@@ -192,13 +193,13 @@ mod tests {
         // The check above is sharp: the Shao–Lo fallback itself misses on the same stencil.
         let phi = |x: f64, y: f64| x * x + y * y;
         let (pairs, nbrs, u, v) = stencil(phi, 0.6);
-        let eta2 = 0.01 * 0.0225;
+        let op = ShaoLo::new(0.15);
         let mut shao_lo = 0.0;
         for (p, &b) in pairs.iter().zip(&nbrs) {
-            shao_lo += (u[0][0] - u[b as usize][0]) * p.f * p.r2() / (p.r2() + eta2) * 2.0 * v;
+            shao_lo += (u[0][0] - u[b as usize][0]) * op.coefficient(p, 2.0 * v, 1.0);
         }
         assert!((shao_lo - 4.0).abs() > 0.02, "Shao–Lo {shao_lo}");
-        let lap = laplacian::<2, 3>(0, &pairs, &nbrs, &u, eta2, v);
+        let lap = laplacian::<2, 3>(0, &pairs, &nbrs, &u, op, v);
         assert!((lap[0] - 4.0).abs() < 1e-9, "{}", lap[0]);
     }
 
@@ -233,7 +234,7 @@ mod tests {
                 }
             }
         }
-        let lap = laplacian::<3, 6>(0, &pairs, &nbrs, &u, 1e-4, dx.powi(3));
+        let lap = laplacian::<3, 6>(0, &pairs, &nbrs, &u, ShaoLo { eta2: 1e-4 }, dx.powi(3));
         // ∇²φ = 2 + 1 − 2 = 1 in every component.
         assert!((lap - Vector::<3>::repeat(1.0)).norm() < 1e-9, "{lap:?}");
     }

@@ -6,16 +6,16 @@
 //! velocity component with the same matrix.
 //!
 //! The matrix `I − Δt ν L` is symmetric positive definite for equal particle volumes (an
-//! M-matrix: `r·∇W ≤ 0`), so it is solved by Jacobi-preconditioned CG (faer), warm-started
+//! M-matrix: `r·∇W ≤ 0`), so it is solved by Jacobi-preconditioned CG ([`crate::linalg`]), warm-started
 //! from `uⁿ`. It removes the explicit viscous limit `Δt ≤ α_d h²/ν` (Qiu eq. 18), which
 //! binds low-Reynolds channels. Boundary neighbours: a mirror (`u = σ u_source`) couples to
 //! its source's unknown with the factor σ; a dummy wall particle's velocity (extrapolated
 //! from `uⁿ`) is known and moves to the right-hand side.
 
 use crate::error::Cause;
-use crate::ppe::{PpeMatrix, PpeSolve, stored};
-use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
-use crate::stage::{Stage, StepContext, par_csr_rows_mut};
+use crate::linalg::{CsrMatrix, LinearSolver, Method, PreconditionerKind, SolverParams, par_csr_rows_mut, stored};
+use crate::operators::ShaoLo;
+use crate::stage::{Stage, StepContext};
 use crate::state::State;
 use rayon::prelude::*;
 
@@ -26,8 +26,8 @@ const TOLERANCE: f64 = 1e-8;
 #[derive(Debug)]
 pub struct ImplicitViscosity {
     nu: f64,
-    matrix: PpeMatrix,
-    solver: PpeSolve,
+    matrix: CsrMatrix,
+    solver: LinearSolver,
     rhs: Vec<f64>,
     x: Vec<f64>,
 }
@@ -35,32 +35,32 @@ pub struct ImplicitViscosity {
 impl ImplicitViscosity {
     /// A stage for kinematic viscosity `nu` = μ/ρ \[m²/s\].
     pub fn new(nu: f64) -> Self {
-        let opts = PpeOptions {
-            solver: PpeSolver::Cg,
+        let params = SolverParams {
+            method: Method::Cg,
             tolerance: TOLERANCE,
             max_iterations: 2000,
-            preconditioner: Preconditioner::Jacobi,
+            preconditioner: PreconditionerKind::Jacobi,
             coarse_refresh: 1,
         };
         Self {
             nu,
-            matrix: PpeMatrix::default(),
-            solver: PpeSolve::new(opts).measuring_residual(false),
+            matrix: CsrMatrix::default(),
+            solver: LinearSolver::new(params).measuring_residual(false),
             rhs: Vec::new(),
             x: Vec::new(),
         }
     }
 }
 
-impl<const D: usize> Stage<D> for ImplicitViscosity {
+impl<const D: usize, O> Stage<D, O> for ImplicitViscosity {
     fn name(&self) -> &'static str {
         "viscosity_implicit"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
         let n = s.particles.fluid;
         let (list, pairs) = (&s.neighbours, &s.pairs);
-        let (eta2, c) = (0.01 * s.h * s.h, ctx.dt * self.nu * 2.0 * s.volume);
+        let (shao_lo, c) = (ShaoLo::new(s.h), ctx.dt * self.nu * 2.0 * s.volume);
         let (source, sign, start) = (&s.mirrors.source, &s.mirrors.sign, s.walls_start());
         // The unknown a neighbour couples to, with its factor (None: a known value, as for
         // open-boundary buffers, dummy wall particles and the mirrors of buffers).
@@ -93,8 +93,8 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
             let mut k = 0;
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                 // −Δt ν L: w = −c (r·∇W)/(r² + η²) ≥ 0 per pair, (u_a − u_b) w; rounded as
-                // stored, here and in the diagonal (see `PpeMatrix`).
-                let w = stored(-c * p.f * p.r2() / (p.r2() + eta2));
+                // stored, here and in the diagonal (see `CsrMatrix`).
+                let w = stored(shao_lo.coefficient(p, -c, 1.0));
                 *diag += w;
                 match column(b as usize) {
                     Some((col, f)) if col as usize == a => *diag -= w * f,
@@ -108,7 +108,7 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
         };
         par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut m.diag, &row);
         m.invert_diagonal();
-        let (u_old, u) = (&s.u_old, &mut s.particles.u);
+        let (u_old, u) = (&s.particles.u_old, &mut s.particles.u);
         for k in 0..D {
             self.rhs.resize(n, 0.0);
             self.rhs.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, r)| {
@@ -116,14 +116,14 @@ impl<const D: usize> Stage<D> for ImplicitViscosity {
                 let mut known = 0.0;
                 for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                     if column(b as usize).is_none() {
-                        known += -c * p.f * p.r2() / (p.r2() + eta2) * u_old[b as usize][k];
+                        known += shao_lo.coefficient(p, -c, 1.0) * u_old[b as usize][k];
                     }
                 }
                 *r = u[a][k] + known;
             });
             self.x.clear();
             self.x.extend(u[..n].iter().map(|u| u[k]));
-            self.solver.solve(&self.matrix, &self.rhs, &mut self.x, false)?;
+            self.solver.solve(&self.matrix, &self.rhs, &mut self.x, false).map_err(super::ppe::cause)?;
             for (u, &x) in u[..n].iter_mut().zip(&self.x) {
                 u[k] = x;
             }

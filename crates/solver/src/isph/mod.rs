@@ -12,39 +12,132 @@
 //! `correction` (eqs. 6, 15) → `position` (eq. 7) →
 //! `shifting` (eqs. 20–21; when configured) → `open_boundaries` (inflow/outflow only:
 //! buffer transfer).
+//!
+//! Own data ([`IsphData`]): the PPE system and the summation density, both rebuilt every
+//! step (no per-particle field to carry). Time step ([`Isph::stable_step`]): the CFL limit
+//! `α_c h/|u|_max`, the viscous limit `α_d ρ h²/μ` when the viscosity is explicit (eq. 18;
+//! smaller by (D+2)/D for the Monaghan–Cleary operator) and the capillary limit when
+//! σ > 0.
 
 pub mod consistent_viscosity;
 pub mod implicit_viscosity;
 pub mod particle_density;
+pub mod ppe;
 pub mod predictor;
 pub mod projection;
 pub mod shifting;
 
+use crate::error::{Cause, SceneError};
+use crate::fields::{ColumnMut, ColumnRef, Field, Fields};
 use crate::kernel::{Kernel, Scaled};
-use crate::ppe::PpeSolve;
-use crate::scene::{IsphOptions, Probe, Scene};
+use crate::linalg::LinearSolver;
+use crate::scene::{IsphOptions, Probe, Scene, Scheme as SceneScheme};
 use crate::scene::{ViscousIntegration, ViscousOperator, WallModel};
-use crate::stage::Stage;
+use crate::scheme::{Adaptive, Composed, Scheme};
+use crate::stage::{Stage, StepContext};
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
-use crate::stages::surface_tension::{Apply, Force, SurfaceTension};
+use crate::stages::surface_tension::{Force, SurfaceTension};
 use crate::stages::young_laplace::SurfacePressure;
 use crate::stages::{free_surface::FreeSurface, reorder::Reorder, walls};
-use crate::state::Vector;
+use crate::state::{State, Vector};
+use crate::time_step;
+use rayon::prelude::*;
 
 /// Particles are reordered by cell every this many steps.
 const REORDER_EVERY: usize = 25;
 
+/// The projection scheme (its parameters; see the module documentation).
+#[derive(Debug)]
+pub struct Isph {
+    /// Dynamic viscosity μ \[Pa s\] (0: inviscid).
+    mu: f64,
+    /// Stiffness of the explicit viscous operator relative to Shao–Lo's; `None` when the
+    /// viscosity is implicit (no viscous limit).
+    viscous_stiffness: Option<f64>,
+    /// Surface-tension coefficient σ \[N/m\].
+    sigma: f64,
+}
+
+/// The projection scheme's own data, rebuilt every step.
+#[derive(Debug, Default)]
+pub struct IsphData {
+    /// The pressure Poisson system of the step.
+    pub ppe: ppe::PpeSystem,
+    /// ρ/ρ₀ by kernel summation (`particle_density`), computed each step before the PPE
+    /// assembly that reads it; empty unless the density relaxation is on.
+    pub particle_density: Vec<f64>,
+}
+
+/// No per-particle field to carry from step to step: both arrays are rebuilt every step
+/// before they are read, so the reorder has nothing of this scheme's to permute.
+impl<const D: usize> Fields<D> for IsphData {
+    fn visit(&self, _: &mut dyn FnMut(Field<ColumnRef<'_, D>>)) {}
+    fn visit_mut(&mut self, _: &mut dyn FnMut(Field<ColumnMut<'_, D>>)) {}
+}
+
+impl<const D: usize> Scheme<D> for Isph {
+    type Own = IsphData;
+
+    fn build<K: Kernel>(scene: &Scene, kernel: Scaled<K, D>) -> Result<Composed<D, Self>, SceneError> {
+        let SceneScheme::Isph(opts) = &scene.scheme else {
+            return Err(SceneError::new("scheme", "not isph", "must be `isph` for the projection scheme"));
+        };
+        let (state, open) = crate::setup::particle_state::<D>(scene, kernel.h, kernel.support)?;
+        let explicit = opts.viscosity == ViscousIntegration::Explicit;
+        // The Monaghan–Cleary operator acts along r̂_ab with weight 2(D+2) against
+        // Shao–Lo's 2 on all components: its largest eigenvalue is (D+2)/D times larger,
+        // so its stable step smaller.
+        let stiffness = match opts.viscous_operator {
+            ViscousOperator::ShaoLo | ViscousOperator::Consistent => 1.0,
+            ViscousOperator::MonaghanCleary => (D as f64 + 2.0) / D as f64,
+        };
+        let scheme = Isph {
+            mu: scene.fluid.viscosity,
+            viscous_stiffness: explicit.then_some(stiffness),
+            sigma: scene.fluid.surface_tension,
+        };
+        let stages = build_stages::<K, D>(scene, opts, kernel, state.domain, open.as_ref());
+        Ok(Composed { scheme, state, own: IsphData::default(), stages })
+    }
+
+    fn stable_step(&self, rule: Adaptive, s: &State<D>, _own: &IsphData) -> f64 {
+        let h = s.h;
+        let mut dt = rule.max.min(time_step::advective(rule.cfl, h, s.max_speed()));
+        if let Some(stiffness) = self.viscous_stiffness {
+            dt = dt.min(time_step::viscous(rule.viscous, s.density, h, self.mu, stiffness));
+        }
+        dt.min(time_step::capillary(s.density, h, self.sigma))
+    }
+}
+
+/// The surface-tension stage of the projection: `u* += Δt a_st` in the predictor.
+impl<const D: usize> Stage<D, IsphData> for SurfaceTension<D> {
+    fn name(&self) -> &'static str {
+        Self::NAME
+    }
+
+    fn run(&mut self, s: &mut State<D>, _own: &mut IsphData, ctx: &StepContext) -> Result<(), Cause> {
+        let dt = ctx.dt;
+        let nf = s.particles.fluid;
+        let accel = self.compute(s, None);
+        s.particles.u[..nf].par_iter_mut().zip(accel.par_iter()).with_min_len(1024).for_each(|(u, st)| {
+            *u += st * dt;
+        });
+        Ok(())
+    }
+}
+
 /// Builds the ISPH stage list for `scene` (`open`: its inflow/outflow, when it has them).
-pub fn build_stages<K: Kernel, const D: usize>(
+fn build_stages<K: Kernel, const D: usize>(
     scene: &Scene,
     opts: &IsphOptions,
     kernel: Scaled<K, D>,
     domain: crate::neighbours::Domain<D>,
     open: Option<&OpenSetup>,
-) -> Vec<Box<dyn Stage<D>>> {
-    let mut stages: Vec<Box<dyn Stage<D>>> =
+) -> Vec<Box<dyn Stage<D, IsphData>>> {
+    let mut stages: Vec<Box<dyn Stage<D, IsphData>>> =
         vec![Box::new(Reorder::new(kernel.support, domain, REORDER_EVERY)), Box::new(predictor::Advect)];
     let g = Vector::<D>::from_fn(|i, _| scene.body_force.get(i).copied().unwrap_or(0.0));
     let walls = (!scene.boundaries.walls.is_empty()).then_some(scene.boundaries.wall_model);
@@ -89,7 +182,6 @@ pub fn build_stages<K: Kernel, const D: usize>(
             force,
             scene.fluid.surface_tension_threshold,
             kernel.h,
-            Apply::Velocity,
         )));
     }
     if nu > 0.0 && implicit {
@@ -111,7 +203,7 @@ pub fn build_stages<K: Kernel, const D: usize>(
         surface_pressure: young_laplace,
     }));
     // Only a `solver` probe reads the measured residual.
-    let solver = PpeSolve::new(opts.ppe)
+    let solver = LinearSolver::new(ppe::solver_params(&opts.ppe))
         .measuring_residual(scene.probes.iter().any(|p| matches!(p, Probe::Solver {})));
     stages.push(Box::new(projection::PpeSolveStage { solver, surface_pressure: young_laplace }));
     if walls == Some(WallModel::Dummy) {

@@ -16,7 +16,7 @@ use crate::stage::{Stage, StepContext};
 use crate::state::State;
 use rayon::prelude::*;
 
-/// Computes `s.particle_density` (ρ/ρ₀, dimensionless) from the pair cache.
+/// Computes `own.particle_density` (ρ/ρ₀, dimensionless) from the pair cache.
 #[derive(Debug)]
 pub struct ParticleDensity<K: Kernel, const D: usize> {
     kernel: Scaled<K, D>,
@@ -35,17 +35,17 @@ impl<K: Kernel, const D: usize> ParticleDensity<K, D> {
     }
 }
 
-impl<K: Kernel, const D: usize> Stage<D> for ParticleDensity<K, D> {
+impl<K: Kernel, const D: usize> Stage<D, super::IsphData> for ParticleDensity<K, D> {
     fn name(&self) -> &'static str {
         "particle_density"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, own: &mut super::IsphData, _ctx: &StepContext) -> Result<(), Cause> {
         let n = s.particles.len();
-        s.particle_density.resize(n, 0.0);
+        own.particle_density.resize(n, 0.0);
         let (list, pairs, kernel, w0, scale) =
             (&s.neighbours, &s.pairs, &self.kernel, self.self_term, self.scale);
-        s.particle_density.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, d)| {
+        own.particle_density.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, d)| {
             let row = &pairs[list.offsets[a]..list.offsets[a + 1]];
             *d = scale * (w0 + row.iter().map(|p| kernel.w(p.r2().sqrt())).sum::<f64>());
         });

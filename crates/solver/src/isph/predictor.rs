@@ -1,6 +1,7 @@
 //! Predictor stages of the projection method (Qiu 2013 §2.2, eqs. 3–4).
 
 use crate::error::Cause;
+use crate::operators::ShaoLo;
 use crate::stage::{Stage, StepContext};
 use crate::state::{State, Vector};
 use rayon::prelude::*;
@@ -9,14 +10,14 @@ use rayon::prelude::*;
 #[derive(Debug)]
 pub struct Advect;
 
-impl<const D: usize> Stage<D> for Advect {
+impl<const D: usize, O> Stage<D, O> for Advect {
     fn name(&self) -> &'static str {
         "advect"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
-        s.x_old.clone_from(&s.particles.x);
-        s.u_old.clone_from(&s.particles.u);
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
+        s.particles.x_old.clone_from(&s.particles.x);
+        s.particles.u_old.clone_from(&s.particles.u);
         let (dt, dom, nf) = (ctx.dt, s.domain, s.particles.fluid);
         let periodic = dom.is_periodic();
         let (x, u) = (&mut s.particles.x[..nf], &s.particles.u[..nf]);
@@ -39,20 +40,20 @@ pub struct Viscosity {
     pub nu: f64,
 }
 
-impl<const D: usize> Stage<D> for Viscosity {
+impl<const D: usize, O> Stage<D, O> for Viscosity {
     fn name(&self) -> &'static str {
         "viscosity"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
-        let eta2 = 0.01 * s.h * s.h;
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
+        let shao_lo = ShaoLo::new(s.h);
         let c = ctx.dt * self.nu * 2.0 * s.volume;
-        let (list, pairs, u_old) = (&s.neighbours, &s.pairs, &s.u_old);
+        let (list, pairs, u_old) = (&s.neighbours, &s.pairs, &s.particles.u_old);
         s.particles.u[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let mut lap = Vector::<D>::zeros();
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                lap += (u_old[a] - u_old[b as usize]) * (p.f * p.r2() / (p.r2() + eta2));
+                lap += (u_old[a] - u_old[b as usize]) * shao_lo.coefficient(p, 1.0, 1.0);
             }
             *u = u_old[a] + lap * c;
         });
@@ -70,21 +71,21 @@ pub struct CentralViscosity {
     pub nu: f64,
 }
 
-impl<const D: usize> Stage<D> for CentralViscosity {
+impl<const D: usize, O> Stage<D, O> for CentralViscosity {
     fn name(&self) -> &'static str {
         "viscosity"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
-        let eta2 = 0.01 * s.h * s.h;
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
+        let shao_lo = ShaoLo::new(s.h);
         let c = ctx.dt * self.nu * 2.0 * (D as f64 + 2.0) * s.volume;
-        let (list, pairs, u_old) = (&s.neighbours, &s.pairs, &s.u_old);
+        let (list, pairs, u_old) = (&s.neighbours, &s.pairs, &s.particles.u_old);
         s.particles.u[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(256).for_each(|(a, u)| {
             let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
             let mut acc = Vector::<D>::zeros();
             for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
                 let u_ab = u_old[a] - u_old[b as usize];
-                acc += p.r_ab * (u_ab.dot(&p.r_ab) * p.f / (p.r2() + eta2));
+                acc += p.r_ab * (u_ab.dot(&p.r_ab) * p.f / shao_lo.denominator(p));
             }
             *u = u_old[a] + acc * c;
         });
@@ -99,12 +100,12 @@ pub struct BodyForce<const D: usize> {
     pub g: Vector<D>,
 }
 
-impl<const D: usize> Stage<D> for BodyForce<D> {
+impl<const D: usize, O> Stage<D, O> for BodyForce<D> {
     fn name(&self) -> &'static str {
         "body_force"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
         let du = self.g * ctx.dt;
         s.particles.u[..s.particles.fluid].par_iter_mut().with_min_len(1024).for_each(|u| *u += du);
         Ok(())

@@ -2,11 +2,12 @@
 //! velocity correction, position update.
 
 use crate::error::Cause;
-use crate::ppe::{PpeSolve, stored};
+use super::IsphData;
+use crate::linalg::{LinearSolver, par_csr_rows_mut, stored};
+use crate::operators::{ShaoLo, corrected_divergence, divergence, moment};
 use crate::scene::{Divergence, PressureGradient};
-use crate::stage::{Stage, StepContext, par_csr_rows_mut};
+use crate::stage::{Stage, StepContext};
 use crate::state::{State, Vector};
-use nalgebra::SMatrix;
 use rayon::prelude::*;
 
 /// Assembles `A p = b` (NUMERICS.md): `A = −L` with the Shao–Lo Laplacian (Qiu eq. 12,
@@ -38,18 +39,18 @@ pub struct PpeAssemble {
     pub surface_pressure: bool,
 }
 
-impl<const D: usize> Stage<D> for PpeAssemble {
+impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
     fn name(&self) -> &'static str {
         "ppe_assemble"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, own: &mut IsphData, ctx: &StepContext) -> Result<(), Cause> {
         let n = s.particles.len();
-        let sys = &mut s.ppe;
+        let sys = &mut own.ppe;
         sys.row_of.resize(s.particles.total(), u32::MAX);
         sys.particle_of.clear();
         for a in 0..n {
-            if s.free_surface[a] {
+            if s.particles.free_surface[a] {
                 sys.row_of[a] = u32::MAX;
             } else {
                 sys.row_of[a] = sys.particle_of.len() as u32;
@@ -95,12 +96,12 @@ impl<const D: usize> Stage<D> for PpeAssemble {
             m.row_ptr[i + 1] += m.row_ptr[i];
         }
         m.resize_entries();
-        let (v, rho, eta2) = (s.volume, s.density, 0.01 * s.h * s.h);
+        let (v, rho, shao_lo) = (s.volume, s.density, ShaoLo::new(s.h));
         let pairs = &s.pairs;
         let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
         self.dt_max = self.dt_max.max(ctx.dt);
         let (p, density, relaxation, dt_max) =
-            (&s.particles.p, &s.particle_density, self.relaxation, self.dt_max);
+            (&s.particles.p, &own.particle_density, self.relaxation, self.dt_max);
         let surface_pressure = self.surface_pressure;
         // One pass over each row's pairs: the matrix row, then (the pairs still in cache)
         // the right-hand side; `row_out` holds (A_ii, b_i) until the diagonal pass below.
@@ -116,33 +117,19 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                     // The particle's own mirror: c (p_a − p_a) = 0.
                     continue;
                 }
-                // Rounded as stored, here and in the diagonal (see `PpeMatrix`).
-                let r2 = p.r2();
-                let c = stored(-2.0 * v * p.f * r2 / (rho * (r2 + eta2)));
+                // Rounded as stored, here and in the diagonal (see `CsrMatrix`).
+                let c = stored(shao_lo.coefficient(p, -2.0 * v, rho));
                 diag += c;
                 if rb != u32::MAX {
                     (cols[k], vals[k]) = (rb, -c as f32);
                     k += 1;
                 }
             }
+            let (row_pairs, nbrs) = (&pairs[lo..hi], &list.indices[lo..hi]);
             let div = if corrected {
-                let mut g = SMatrix::<f64, D, D>::zeros();
-                let mut m = SMatrix::<f64, D, D>::zeros();
-                for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                    let grad = p.r_ab * p.f;
-                    g += (u[b as usize] - u[a]) * grad.transpose();
-                    m -= p.r_ab * grad.transpose();
-                }
-                match m.try_inverse() {
-                    Some(mi) => (g * mi).trace(),
-                    None => v * g.trace(),
-                }
+                corrected_divergence(u, a, row_pairs, nbrs, v)
             } else {
-                let mut div = 0.0;
-                for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                    div += (u[b as usize] - u[a]).dot(&p.r_ab) * p.f;
-                }
-                v * div
+                divergence(u, a, row_pairs, nbrs, v)
             };
             // Known boundary pressures (dummy walls) move to the right-hand side.
             let mut known = 0.0;
@@ -151,8 +138,7 @@ impl<const D: usize> Stage<D> for PpeAssemble {
                     let boundary = b as usize >= n && known_boundary;
                     let surface = (b as usize) < n && surface_pressure;
                     if (boundary || surface) && row_of[b as usize] == u32::MAX {
-                        let r2 = pr.r2();
-                        known += -2.0 * v * pr.f * r2 / (rho * (r2 + eta2)) * p[b as usize];
+                        known += shao_lo.coefficient(pr, -2.0 * v, rho) * p[b as usize];
                     }
                 }
             }
@@ -185,19 +171,19 @@ impl<const D: usize> Stage<D> for PpeAssemble {
 #[derive(Debug)]
 pub struct PpeSolveStage {
     /// The configured solver.
-    pub solver: PpeSolve,
+    pub solver: LinearSolver,
     /// Keep the free-surface pressures set before the solve (see
     /// [`PpeAssemble::surface_pressure`]).
     pub surface_pressure: bool,
 }
 
-impl<const D: usize> Stage<D> for PpeSolveStage {
+impl<const D: usize> Stage<D, IsphData> for PpeSolveStage {
     fn name(&self) -> &'static str {
         "ppe_solve"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
-        let sys = &mut s.ppe;
+    fn run(&mut self, s: &mut State<D>, own: &mut IsphData, _ctx: &StepContext) -> Result<(), Cause> {
+        let sys = &mut own.ppe;
         let p = &mut s.particles.p;
         sys.solution.resize(sys.particle_of.len(), 0.0);
         for (x, &a) in sys.solution.iter_mut().zip(&sys.particle_of) {
@@ -212,7 +198,10 @@ impl<const D: usize> Stage<D> for PpeSolveStage {
         } else {
             None
         };
-        sys.info = self.solver.solve_keyed(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular, keys)?;
+        s.solve = self
+            .solver
+            .solve_keyed(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular, keys)
+            .map_err(super::ppe::cause)?;
         // Free-surface particles get p = 0 (or keep their Young–Laplace value); boundary
         // particles keep their known values.
         if !self.surface_pressure {
@@ -245,12 +234,12 @@ pub struct Correction {
     pub form: PressureGradient,
 }
 
-impl<const D: usize> Stage<D> for Correction {
+impl<const D: usize, O> Stage<D, O> for Correction {
     fn name(&self) -> &'static str {
         "correction"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
         let (list, pairs, p) = (&s.neighbours, &s.pairs, &s.particles.p);
         let c = ctx.dt * s.volume / s.density;
         let sign = match self.form {
@@ -266,12 +255,8 @@ impl<const D: usize> Stage<D> for Correction {
                 g += pr.r_ab * (pr.f * (p[b as usize] + sign * p[a]));
             }
             if corrected {
-                // m = Σ_b (r_b − r_a) ⊗ ∇_aW_ab (symmetric), so ∇p_a = (V m)⁻¹ (V g).
-                let mut m = SMatrix::<f64, D, D>::zeros();
-                for pr in &pairs[lo..hi] {
-                    m -= pr.r_ab * pr.r_ab.transpose() * pr.f;
-                }
-                if let Some(mi) = m.try_inverse() {
+                // ∇p_a = (V M)⁻¹ (V g) with the moment matrix M (symmetric).
+                if let Some(mi) = moment(&pairs[lo..hi]).try_inverse() {
                     *u -= mi * g * dt_rho;
                     return;
                 }
@@ -286,15 +271,15 @@ impl<const D: usize> Stage<D> for Correction {
 #[derive(Debug)]
 pub struct Position;
 
-impl<const D: usize> Stage<D> for Position {
+impl<const D: usize, O> Stage<D, O> for Position {
     fn name(&self) -> &'static str {
         "position"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
         let (dt, dom) = (ctx.dt, s.domain);
         let periodic = dom.is_periodic();
-        let (x_old, u_old, u) = (&s.x_old, &s.u_old, &s.particles.u);
+        let (x_old, u_old, u) = (&s.particles.x_old, &s.particles.u_old, &s.particles.u);
         s.particles.x[..s.particles.fluid].par_iter_mut().enumerate().with_min_len(512).for_each(|(a, x)| {
             *x = x_old[a] + (u[a] + u_old[a]) * (0.5 * dt);
             if periodic {

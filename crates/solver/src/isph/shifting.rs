@@ -85,19 +85,19 @@ impl<K: Kernel, const D: usize> Shifting<K, D> {
     }
 }
 
-impl<K: Kernel, const D: usize> Stage<D> for Shifting<K, D> {
+impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
     fn name(&self) -> &'static str {
         "shifting"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
         let n = s.particles.len();
         self.shift.resize(n, Vector::zeros());
         self.du.resize(n, Vector::zeros());
         let u_max = s.max_speed();
         let (k, law, dt, v, dom) = (self.kernel, self.law, ctx.dt, s.volume, s.domain);
         let (u, list, pairs) = (&s.particles.u, &s.neighbours, &s.pairs);
-        let (div_r, threshold, cap) = (&s.div_r, self.threshold, MAX_SHIFT * s.dx);
+        let (div_r, threshold, cap) = (&s.particles.div_r, self.threshold, MAX_SHIFT * s.dx);
         let (xu, smooth) = match law {
             Law::Xu { smooth, .. } => (true, smooth),
             Law::Fickian(_) => (false, false),

@@ -540,7 +540,7 @@ pub struct PpeOptions {
 }
 
 fn default_coarse_refresh() -> usize {
-    crate::two_level::DEFAULT_REFRESH
+    crate::linalg::two_level::DEFAULT_REFRESH
 }
 
 /// Preconditioners of the Krylov PPE solvers.

@@ -102,7 +102,7 @@ impl<K: Kernel, const D: usize> DummyWalls<K, D> {
     }
 }
 
-impl<K: Kernel, const D: usize> Stage<D> for DummyWalls<K, D> {
+impl<K: Kernel, const D: usize, O> Stage<D, O> for DummyWalls<K, D> {
     fn name(&self) -> &'static str {
         match self.what {
             Extrapolate::Start => "dummy_walls",
@@ -111,7 +111,7 @@ impl<K: Kernel, const D: usize> Stage<D> for DummyWalls<K, D> {
         }
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
         let (nf, total) = (s.particles.fluid, s.particles.total());
         let (list, pairs, k, g, rho) = (&s.neighbours, &s.pairs, self.kernel, self.g, s.density);
         let (u, p) = (&s.particles.u, &s.particles.p);
@@ -140,7 +140,7 @@ impl<K: Kernel, const D: usize> Stage<D> for DummyWalls<K, D> {
                 s.particles.u[w] = uw;
             }
             if what == Extrapolate::Start {
-                s.u_old[w] = uw;
+                s.particles.u_old[w] = uw;
             }
             if what != Extrapolate::Velocity {
                 s.particles.p[w] = pw;

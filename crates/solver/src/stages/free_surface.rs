@@ -16,17 +16,17 @@ pub struct FreeSurface {
     pub threshold: f64,
 }
 
-impl<const D: usize> Stage<D> for FreeSurface {
+impl<const D: usize, O> Stage<D, O> for FreeSurface {
     fn name(&self) -> &'static str {
         "free_surface"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
         let n = s.particles.len();
-        s.div_r.resize(n, 0.0);
-        s.free_surface.resize(n, false);
+        s.particles.div_r.resize(n, 0.0);
+        s.particles.free_surface.resize(n, false);
         let t = self.threshold;
-        s.free_surface.par_iter_mut().zip(&s.div_r).with_min_len(1024).for_each(|(fs, d)| *fs = *d < t);
+        s.particles.free_surface.par_iter_mut().zip(&s.particles.div_r).with_min_len(1024).for_each(|(fs, d)| *fs = *d < t);
         Ok(())
     }
 }

@@ -43,12 +43,12 @@ impl<K: Kernel, const D: usize> Neighbours<K, D> {
     }
 }
 
-impl<K: Kernel, const D: usize> Stage<D> for Neighbours<K, D> {
+impl<K: Kernel, const D: usize, O> Stage<D, O> for Neighbours<K, D> {
     fn name(&self) -> &'static str {
         "neighbours"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
         let rows = match self.rows {
             Rows::Fluid => s.particles.fluid,
             Rows::All => s.particles.total(),
@@ -58,8 +58,8 @@ impl<K: Kernel, const D: usize> Stage<D> for Neighbours<K, D> {
         s.pairs.resize(n_pairs, Pair::default());
         let (x, list, dom, k, v, div_r) =
             (&s.particles.x, &s.neighbours, s.domain, self.kernel, s.volume, self.div_r);
-        s.div_r.resize(rows, 0.0);
-        par_rows_mut(&list.offsets, &mut s.pairs, &mut s.div_r, &|a, row: &mut [Pair<D>], d: &mut f64| {
+        s.particles.div_r.resize(rows, 0.0);
+        par_rows_mut(&list.offsets, &mut s.pairs, &mut s.particles.div_r, &|a, row: &mut [Pair<D>], d: &mut f64| {
             for (pair, &b) in row.iter_mut().zip(list.of(a)) {
                 let r_ab = dom.displacement(&x[a], &x[b as usize]);
                 let r2 = r_ab.norm_squared();

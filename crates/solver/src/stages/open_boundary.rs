@@ -20,6 +20,7 @@
 //! counted in [`crate::state::Flux`] (the `mass_balance` probe).
 
 use crate::error::{Cause, SceneError};
+use crate::fields::{Fields, retain};
 use crate::scene::{Inflow, Outflow};
 use crate::stage::{Stage, StepContext};
 use crate::state::{InletLink, Particles, State, Vector};
@@ -150,22 +151,24 @@ pub struct OpenBoundaries<const D: usize> {
     scratch: Vec<(Vector<D>, Vector<D>, f64)>,
     /// Fluid particles entering this step (x, u, p, inlet row).
     entering: Vec<(Vector<D>, Vector<D>, f64, usize)>,
+    /// Which fluid particles stay in the fluid this step.
+    keep: Vec<bool>,
 }
 
 impl<const D: usize> OpenBoundaries<D> {
     /// The stage for the open boundaries of `setup`.
     pub fn new(setup: &OpenSetup) -> Self {
         let (open, inlet, next_id) = (setup.openings, setup.inlet, setup.next_id);
-        Self { open, inlet, next_id, scratch: Vec::new(), entering: Vec::new() }
+        Self { open, inlet, next_id, scratch: Vec::new(), entering: Vec::new(), keep: Vec::new() }
     }
 }
 
-impl<const D: usize> Stage<D> for OpenBoundaries<D> {
+impl<const D: usize, O: Fields<D>> Stage<D, O> for OpenBoundaries<D> {
     fn name(&self) -> &'static str {
         "open_boundaries"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
         let o = self.open;
         let (k, nf, nb) = (o.axis, s.particles.fluid, s.buffer);
         let mass = s.density * s.volume;
@@ -191,36 +194,26 @@ impl<const D: usize> Stage<D> for OpenBoundaries<D> {
                 self.scratch.push((x, p.u[i], 0.0));
             }
         }
-        // Compact the fluid: particles past the outlet join the outlet buffer; a particle
-        // pushed upstream of the inlet plane is reflected back.
-        let mut kept = 0;
+        // Compact the fluid (every declared field): particles past the outlet join the
+        // outlet buffer; a particle pushed upstream of the inlet plane is reflected back.
+        self.keep.clear();
         let mut left = 0usize;
         for a in 0..nf {
-            let mut x = p.x[a];
+            let x = &mut p.x[a];
             if x[k] < o.inlet {
                 x[k] = 2.0 * o.inlet - x[k];
             }
-            if x[k] >= o.outlet {
+            let leaves = x[k] >= o.outlet;
+            if leaves {
                 let mut u = Vector::<D>::zeros();
                 u[k] = p.u[a][k].max(0.0);
-                self.scratch.push((x, u, 0.0));
+                self.scratch.push((*x, u, 0.0));
                 left += 1;
-                continue;
             }
-            p.x[kept] = x;
-            p.u[kept] = p.u[a];
-            p.p[kept] = p.p[a];
-            p.id[kept] = p.id[a];
-            s.free_surface[kept] = s.free_surface[a];
-            s.div_r[kept] = s.div_r[a];
-            kept += 1;
+            self.keep.push(!leaves);
         }
-        p.x.truncate(kept);
-        p.u.truncate(kept);
-        p.p.truncate(kept);
-        p.id.truncate(kept);
-        s.free_surface.truncate(kept);
-        s.div_r.truncate(kept);
+        retain(p, &self.keep);
+        retain(own, &self.keep);
         for &(x, u, pr, row) in &self.entering {
             p.x.push(x);
             p.u.push(u);
@@ -228,8 +221,8 @@ impl<const D: usize> Stage<D> for OpenBoundaries<D> {
             p.id.push(self.next_id);
             s.inlet.row_id[row] = self.next_id;
             self.next_id += 1;
-            s.free_surface.push(false);
-            s.div_r.push(0.0);
+            p.free_surface.push(false);
+            p.div_r.push(0.0);
         }
         p.fluid = p.x.len();
         for &(x, u, pr) in &self.scratch {
@@ -258,12 +251,12 @@ impl<const D: usize> Stage<D> for OpenBoundaries<D> {
 #[derive(Debug)]
 pub struct InletSources;
 
-impl<const D: usize> Stage<D> for InletSources {
+impl<const D: usize, O> Stage<D, O> for InletSources {
     fn name(&self) -> &'static str {
         "inlet_sources"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
         let link = &mut s.inlet;
         let rows = link.row_id.len();
         // (id, row) sorted by id, to look up every fluid particle's id once.

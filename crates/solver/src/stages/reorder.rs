@@ -3,9 +3,12 @@
 use crate::error::Cause;
 use crate::neighbours::{CellSearch, Domain};
 use crate::stage::{Stage, StepContext};
-use crate::state::{PermuteScratch, State};
+use crate::fields::{Fields, PermuteScratch, permute};
+use crate::state::State;
 
-/// Every `every` steps (from the first), permutes the fluid particles into cell order.
+/// Every `every` steps (from the first), permutes the fluid particles into cell order:
+/// every declared per-particle field, the shared ones and the scheme's own
+/// ([`crate::fields`]).
 /// Boundary particles are rebuilt after it (the wall stage comes later in the step), so
 /// their sources always index the current order.
 #[derive(Debug)]
@@ -28,15 +31,16 @@ impl<const D: usize> Reorder<D> {
     }
 }
 
-impl<const D: usize> Stage<D> for Reorder<D> {
+impl<const D: usize, O: Fields<D>> Stage<D, O> for Reorder<D> {
     fn name(&self) -> &'static str {
         "reorder"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
         if self.calls.is_multiple_of(self.every) {
             let perm = self.search.cell_order(&s.particles.x[..s.particles.fluid]);
-            s.permute(perm, &mut self.scratch);
+            permute(&mut s.particles, perm, &mut self.scratch);
+            permute(own, perm, &mut self.scratch);
         }
         self.calls += 1;
         Ok(())

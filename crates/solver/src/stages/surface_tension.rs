@@ -26,10 +26,9 @@
 //! acceleration is added to the WCSPH acceleration ([`Apply::Acceleration`]) or applied to
 //! the ISPH predicted velocity as `u* += Δt a` ([`Apply::Velocity`]).
 
-use crate::error::Cause;
 use crate::kernel::{Kernel, Scaled};
 use crate::scene::SurfaceTensionModel;
-use crate::stage::{Stage, StepContext};
+
 use crate::state::{State, Vector};
 use nalgebra::SMatrix;
 use rayon::prelude::*;
@@ -105,22 +104,14 @@ impl Force {
     }
 }
 
-/// Where the surface-tension acceleration goes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Apply {
-    /// Added to `State::wc.accel` (WCSPH, before the second half kick).
-    Acceleration,
-    /// `u += Δt a` on the fluid (ISPH predictor).
-    Velocity,
-}
-
-/// The surface-tension stage (see the module documentation).
+/// The surface-tension acceleration (see the module documentation): [`SurfaceTension::compute`]
+/// fills it; each scheme's stage applies it (ISPH: `u += Δt a` in the predictor; WCSPH:
+/// added to the acceleration before the second half kick).
 #[derive(Debug)]
 pub struct SurfaceTension<const D: usize> {
     /// σ \[N/m\].
     sigma: f64,
     model: Force,
-    apply: Apply,
     /// ε = 0.01/h \[1/m\].
     eps: f64,
     /// Colour gradient n of the fluid \[1/m\].
@@ -135,21 +126,23 @@ impl<const D: usize> SurfaceTension<D> {
     /// A stage with coefficient `sigma` \[N/m\] (already divided by the surface-delta
     /// integral when normalised, see [`flat_surface_delta`]), smoothing length `h` \[m\]
     /// and the normal threshold `ε = threshold / h`.
-    pub fn new(sigma: f64, model: Force, threshold: f64, h: f64, apply: Apply) -> Self {
-        Self { sigma, model, apply, eps: threshold / h, n: Vec::new(), stress: Vec::new(), accel: Vec::new() }
+    pub fn new(sigma: f64, model: Force, threshold: f64, h: f64) -> Self {
+        Self { sigma, model, eps: threshold / h, n: Vec::new(), stress: Vec::new(), accel: Vec::new() }
     }
 }
 
-impl<const D: usize> Stage<D> for SurfaceTension<D> {
-    fn name(&self) -> &'static str {
-        "surface_tension"
-    }
+impl<const D: usize> SurfaceTension<D> {
+    /// The stage name of every scheme's surface-tension stage.
+    pub const NAME: &'static str = "surface_tension";
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    /// Computes the surface-tension acceleration of every fluid particle \[m/s²\] from the
+    /// step's pairs; `rho`: the particle densities of a compressible scheme (all
+    /// particles), volumes `m/ρ` then; otherwise V and ρ₀.
+    pub fn compute(&mut self, s: &State<D>, rho: Option<&[f64]>) -> &[Vector<D>] {
         let (nf, total) = (s.particles.fluid, s.particles.total());
         let (list, pairs) = (&s.neighbours, &s.pairs);
         let mass = s.density * s.volume;
-        let rho = &s.wc.rho;
+        let rho = rho.unwrap_or(&[]);
         let wc = rho.len() >= total;
         let v0 = s.volume;
         let vol = |b: usize| if wc { mass / rho[b] } else { v0 };
@@ -225,24 +218,7 @@ impl<const D: usize> Stage<D> for SurfaceTension<D> {
                 });
             }
         }
-        match self.apply {
-            Apply::Acceleration => {
-                s.wc.accel[..nf].par_iter_mut().zip(self.accel.par_iter()).with_min_len(1024).for_each(
-                    |(a, st)| {
-                        *a += st;
-                    },
-                );
-            }
-            Apply::Velocity => {
-                let dt = ctx.dt;
-                s.particles.u[..nf].par_iter_mut().zip(self.accel.par_iter()).with_min_len(1024).for_each(
-                    |(u, st)| {
-                        *u += st * dt;
-                    },
-                );
-            }
-        }
-        Ok(())
+        &self.accel
     }
 }
 

@@ -35,12 +35,12 @@ impl Walls {
     }
 }
 
-impl<const D: usize> Stage<D> for Walls {
+impl<const D: usize, O> Stage<D, O> for Walls {
     fn name(&self) -> &'static str {
         "walls"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
         // Fluid and open-boundary buffers are mirrored (a buffer near a wall needs its
         // mirrors as much as the fluid does).
         let nf = s.walls_start();
@@ -48,7 +48,7 @@ impl<const D: usize> Stage<D> for Walls {
         p.x.truncate(nf);
         p.u.truncate(nf);
         p.p.truncate(nf);
-        s.u_old.truncate(nf);
+        p.u_old.truncate(nf);
         s.mirrors.source.clear();
         s.mirrors.sign.clear();
         let mut near = [0usize; 3];
@@ -91,7 +91,7 @@ impl<const D: usize> Stage<D> for Walls {
             let src = src as usize;
             p.u.push(p.u[src] * sign);
             p.p.push(p.p[src]);
-            s.u_old.push(s.u_old[src] * sign);
+            p.u_old.push(p.u_old[src] * sign);
         }
         Ok(())
     }
@@ -102,12 +102,12 @@ impl<const D: usize> Stage<D> for Walls {
 #[derive(Debug)]
 pub struct MirrorVelocity;
 
-impl<const D: usize> Stage<D> for MirrorVelocity {
+impl<const D: usize, O> Stage<D, O> for MirrorVelocity {
     fn name(&self) -> &'static str {
         "mirror_velocity"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
         let start = s.walls_start();
         let (fluid, mirrors) = s.particles.u.split_at_mut(start);
         for ((u, &src), &sign) in mirrors.iter_mut().zip(&s.mirrors.source).zip(&s.mirrors.sign) {

@@ -93,7 +93,7 @@ fn surface_curvature<K: Kernel, const D: usize>(
     let mut m = na * na.transpose();
     for (p, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
         let b = b as usize;
-        if b >= s.particles.fluid || !s.free_surface[b] {
+        if b >= s.particles.fluid || !s.particles.free_surface[b] {
             continue;
         }
         let Some(nb) = normal.get(b).copied().filter(|n| n.norm_squared() > 0.25) else {
@@ -109,12 +109,12 @@ fn surface_curvature<K: Kernel, const D: usize>(
     Some(-(g * mi).trace())
 }
 
-impl<K: Kernel, const D: usize> Stage<D> for SurfacePressure<K, D> {
+impl<K: Kernel, const D: usize, O> Stage<D, O> for SurfacePressure<K, D> {
     fn name(&self) -> &'static str {
         "surface_pressure"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
         let nf = s.particles.fluid;
         unit_normals(s, self.eps, &mut self.normal);
         let normal = &self.normal;
@@ -123,7 +123,7 @@ impl<K: Kernel, const D: usize> Stage<D> for SurfacePressure<K, D> {
             .into_par_iter()
             .with_min_len(256)
             .map(|a| {
-                if state.free_surface[a] {
+                if state.particles.free_surface[a] {
                     surface_curvature(state, normal, &self.kernel, a).unwrap_or(f64::NAN)
                 } else {
                     f64::NAN
@@ -132,7 +132,7 @@ impl<K: Kernel, const D: usize> Stage<D> for SurfacePressure<K, D> {
             .collect();
         shepard(s, &self.kernel, &raw, &mut self.kappa);
         let (sigma, half) = (self.sigma, 0.5 * s.dx);
-        let (kappa, fs) = (&self.kappa, &s.free_surface);
+        let (kappa, fs) = (&self.kappa, &s.particles.free_surface);
         s.particles.p[..nf].par_iter_mut().enumerate().with_min_len(1024).for_each(|(a, p)| {
             if fs[a] {
                 let k = kappa[a].clamp(-0.5 / half, 0.5 / half);

@@ -23,9 +23,11 @@
 //! Boundary particles (mirrors, dummy walls) enter with their velocity and pressure; their
 //! density is the inverse Tait density of their pressure.
 
+use super::WcFields;
 use super::eos::Tait;
 use crate::error::Cause;
 use crate::kernel::{Kernel, Scaled};
+use crate::operators::ShaoLo;
 use crate::stage::{Stage, StepContext};
 use crate::state::{State, Vector};
 use nalgebra::SMatrix;
@@ -72,7 +74,7 @@ pub fn continuity<K: Kernel, const D: usize>(
     params: ForceParams<D>,
     kernel: Scaled<K, D>,
     corrected: bool,
-) -> Box<dyn Stage<D>> {
+) -> Box<dyn Stage<D, WcFields<D>>> {
     match (params.delta > 0.0, corrected) {
         (true, false) => Box::new(Continuity::<K, D, true, false> { params, kernel }),
         (false, false) => Box::new(Continuity::<K, D, false, false> { params, kernel }),
@@ -81,22 +83,21 @@ pub fn continuity<K: Kernel, const D: usize>(
     }
 }
 
-impl<K: Kernel, const D: usize, const DIFF: bool, const CORR: bool> Stage<D>
+impl<K: Kernel, const D: usize, const DIFF: bool, const CORR: bool> Stage<D, WcFields<D>>
     for Continuity<K, D, DIFF, CORR>
 {
     fn name(&self) -> &'static str {
         "continuity"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, wc: &mut WcFields<D>, ctx: &StepContext) -> Result<(), Cause> {
         let prm = self.params;
         let (nf, total) = (s.particles.fluid, s.particles.total());
-        boundary_density(s, &prm.eos);
-        let wc = &mut s.wc;
+        boundary_density(s, wc, &prm.eos);
         wc.drho.resize(nf, 0.0);
         let (list, pairs, u, rho, k) = (&s.neighbours, &s.pairs, &s.particles.u, &wc.rho, self.kernel);
         let m = prm.mass;
-        let eta2 = 0.01 * prm.h * prm.h;
+        let shao_lo = ShaoLo::new(prm.h);
         let diff_c = prm.delta * prm.h * prm.c0 * 2.0 * m;
         let half = 0.5 * ctx.dt;
         wc.drho.par_iter_mut().enumerate().with_min_len(128).for_each(|(a, drho)| {
@@ -119,7 +120,7 @@ impl<K: Kernel, const D: usize, const DIFF: bool, const CORR: bool> Stage<D>
                 }
                 if DIFF {
                     let rb = rho[b];
-                    sum += diff_c * (ra - rb) * pair.f * pair.r2() / ((pair.r2() + eta2) * rb);
+                    sum += shao_lo.coefficient(pair, diff_c * (ra - rb), rb);
                 }
             }
             if CORR {
@@ -146,16 +147,16 @@ impl<K: Kernel, const D: usize, const DIFF: bool, const CORR: bool> Stage<D>
 }
 
 /// Densities of the boundary particles from their pressures (inverse Tait equation).
-fn boundary_density<const D: usize>(s: &mut State<D>, eos: &Tait) {
+fn boundary_density<const D: usize>(s: &State<D>, wc: &mut WcFields<D>, eos: &Tait) {
     let (nf, total) = (s.particles.fluid, s.particles.total());
-    s.wc.rho.resize(total, eos.rho0);
+    wc.rho.resize(total, eos.rho0);
     let p = &s.particles.p;
-    s.wc.rho[nf..].par_iter_mut().zip(p[nf..].par_iter()).with_min_len(512).for_each(|(r, &pb)| {
+    wc.rho[nf..].par_iter_mut().zip(p[nf..].par_iter()).with_min_len(512).for_each(|(r, &pb)| {
         *r = eos.density(pb);
     });
 }
 
-/// Computes the acceleration of every fluid particle into [`crate::state::WcFields`]
+/// Computes the acceleration of every fluid particle into [`WcFields::accel`]
 /// (pressure gradient, laminar and artificial viscosity, body force). The terms a scene
 /// does not use are compiled out (`AV`: artificial viscosity, `VISC`: laminar viscosity).
 #[derive(Debug)]
@@ -165,7 +166,7 @@ pub struct Momentum<const D: usize, const AV: bool, const VISC: bool> {
 }
 
 /// The [`Momentum`] stage with exactly the terms `params` needs.
-pub fn momentum<const D: usize>(params: ForceParams<D>) -> Box<dyn Stage<D>> {
+pub fn momentum<const D: usize>(params: ForceParams<D>) -> Box<dyn Stage<D, WcFields<D>>> {
     let av = params.alpha > 0.0 || params.beta > 0.0;
     let visc = params.mu > 0.0;
     match (av, visc) {
@@ -176,20 +177,19 @@ pub fn momentum<const D: usize>(params: ForceParams<D>) -> Box<dyn Stage<D>> {
     }
 }
 
-impl<const D: usize, const AV: bool, const VISC: bool> Stage<D> for Momentum<D, AV, VISC> {
+impl<const D: usize, const AV: bool, const VISC: bool> Stage<D, WcFields<D>> for Momentum<D, AV, VISC> {
     fn name(&self) -> &'static str {
         "momentum"
     }
 
-    fn run(&mut self, s: &mut State<D>, _ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, wc: &mut WcFields<D>, _ctx: &StepContext) -> Result<(), Cause> {
         let prm = self.params;
         let nf = s.particles.fluid;
-        boundary_density(s, &prm.eos);
-        let wc = &mut s.wc;
+        boundary_density(s, wc, &prm.eos);
         wc.accel.resize(nf, Vector::zeros());
         let (list, pairs, u, rho, p) = (&s.neighbours, &s.pairs, &s.particles.u, &wc.rho, &s.particles.p);
         let m = prm.mass;
-        let eta2 = 0.01 * prm.h * prm.h;
+        let shao_lo = ShaoLo::new(prm.h);
         let visc_c = 8.0 * prm.mu * m;
         let (ac, bc) = (prm.alpha * prm.c0, prm.beta);
         wc.accel.par_iter_mut().enumerate().with_min_len(128).for_each(|(a, acc)| {
@@ -207,13 +207,13 @@ impl<const D: usize, const AV: bool, const VISC: bool> Stage<D> for Momentum<D, 
                     if AV {
                         let vr = u_ab.dot(&pair.r_ab);
                         if vr < 0.0 {
-                            let mu_ab = prm.h * vr / (pair.r2() + eta2);
+                            let mu_ab = prm.h * vr / shao_lo.denominator(pair);
                             s_grad -= m * (-ac * mu_ab + bc * mu_ab * mu_ab) * 2.0 / (ra + rb);
                         }
                     }
                     if VISC {
                         let rs = ra + rb;
-                        sum += u_ab * (visc_c * pair.f * pair.r2() / ((pair.r2() + eta2) * rs * rs));
+                        sum += u_ab * (visc_c * pair.f * pair.r2() / (shao_lo.denominator(pair) * rs * rs));
                     }
                 }
                 sum += pair.r_ab * (pair.f * s_grad);

@@ -15,6 +15,7 @@
 //! the elliptical drop: blow-up at c₀Δt/h = 0.14). The forces of the initial state are
 //! computed once, before the first kick ([`Prime`]).
 
+use super::WcFields;
 use super::eos::Tait;
 use crate::error::Cause;
 use crate::stage::{Stage, StepContext};
@@ -25,19 +26,19 @@ use rayon::prelude::*;
 #[derive(Debug)]
 pub struct KickDrift;
 
-impl<const D: usize> Stage<D> for KickDrift {
+impl<const D: usize> Stage<D, WcFields<D>> for KickDrift {
     fn name(&self) -> &'static str {
         "kick_drift"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
-        s.x_old.clone_from(&s.particles.x);
-        s.u_old.clone_from(&s.particles.u);
+    fn run(&mut self, s: &mut State<D>, own: &mut WcFields<D>, ctx: &StepContext) -> Result<(), Cause> {
+        s.particles.x_old.clone_from(&s.particles.x);
+        s.particles.u_old.clone_from(&s.particles.u);
         let (dt, dom, nf) = (ctx.dt, s.domain, s.particles.fluid);
         let periodic = dom.is_periodic();
         let half = 0.5 * dt;
         let p = &mut s.particles;
-        (&mut p.x[..nf], &mut p.u[..nf], &s.wc.accel[..nf]).into_par_iter().with_min_len(512).for_each(
+        (&mut p.x[..nf], &mut p.u[..nf], &own.accel[..nf]).into_par_iter().with_min_len(512).for_each(
             |(x, u, a)| {
                 *u += a * half;
                 *x += *u * dt;
@@ -54,14 +55,14 @@ impl<const D: usize> Stage<D> for KickDrift {
 #[derive(Debug)]
 pub struct Kick;
 
-impl<const D: usize> Stage<D> for Kick {
+impl<const D: usize> Stage<D, WcFields<D>> for Kick {
     fn name(&self) -> &'static str {
         "kick"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, own: &mut WcFields<D>, ctx: &StepContext) -> Result<(), Cause> {
         let (nf, half) = (s.particles.fluid, 0.5 * ctx.dt);
-        s.particles.u[..nf].par_iter_mut().zip(s.wc.accel[..nf].par_iter()).with_min_len(512).for_each(
+        s.particles.u[..nf].par_iter_mut().zip(own.accel[..nf].par_iter()).with_min_len(512).for_each(
             |(u, a)| {
                 *u += a * half;
             },
@@ -77,38 +78,38 @@ impl<const D: usize> Stage<D> for Kick {
 #[derive(Debug)]
 pub struct Prime<const D: usize> {
     eos: Tait,
-    stages: Vec<Box<dyn Stage<D>>>,
+    stages: Vec<Box<dyn Stage<D, WcFields<D>>>>,
     done: bool,
 }
 
 impl<const D: usize> Prime<D> {
     /// Primes with `stages` (boundaries, neighbours, forces, surface tension).
-    pub fn new(eos: Tait, stages: Vec<Box<dyn Stage<D>>>) -> Self {
+    pub fn new(eos: Tait, stages: Vec<Box<dyn Stage<D, WcFields<D>>>>) -> Self {
         Self { eos, stages, done: false }
     }
 }
 
-impl<const D: usize> Stage<D> for Prime<D> {
+impl<const D: usize> Stage<D, WcFields<D>> for Prime<D> {
     fn name(&self) -> &'static str {
         "wcsph_prime"
     }
 
-    fn run(&mut self, s: &mut State<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, own: &mut WcFields<D>, ctx: &StepContext) -> Result<(), Cause> {
         if self.done {
             return Ok(());
         }
         let nf = s.particles.fluid;
         let eos = self.eos;
-        s.wc.rho.clear();
-        s.wc.rho.extend(s.particles.p[..nf].iter().map(|&p| eos.density(p)));
-        s.wc.accel.clear();
-        s.wc.accel.resize(nf, Vector::zeros());
-        s.wc.drho.clear();
-        s.wc.drho.resize(nf, 0.0);
-        s.x_old.clone_from(&s.particles.x);
-        s.u_old.clone_from(&s.particles.u);
+        own.rho.clear();
+        own.rho.extend(s.particles.p[..nf].iter().map(|&p| eos.density(p)));
+        own.accel.clear();
+        own.accel.resize(nf, Vector::zeros());
+        own.drho.clear();
+        own.drho.resize(nf, 0.0);
+        s.particles.x_old.clone_from(&s.particles.x);
+        s.particles.u_old.clone_from(&s.particles.u);
         for stage in &mut self.stages {
-            stage.run(s, ctx)?;
+            stage.run(s, own, ctx)?;
         }
         self.done = true;
         Ok(())

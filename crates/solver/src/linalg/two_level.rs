@@ -44,8 +44,8 @@
 //!
 //! faer has no incomplete factorisation or AMG, hence this small hand-written coarse space.
 
-use crate::krylov::Preconditioner;
-use crate::ppe::PpeMatrix;
+use super::CsrMatrix;
+use super::krylov::Preconditioner;
 use faer::dyn_stack::{MemBuffer, MemStack, StackReq};
 use faer::linalg::cholesky::llt::factor::LltRegularization;
 use faer::sparse::linalg::cholesky::{
@@ -197,7 +197,7 @@ impl CoarseSpace {
     /// rows to the kept aggregates through `keys` (one per row). Returns whether a coarse
     /// correction is available (a coarse matrix that faer cannot factorise leaves Jacobi
     /// alone).
-    pub fn prepare(&mut self, a: &PpeMatrix, keys: Option<&[u32]>, singular: bool) -> bool {
+    pub fn prepare(&mut self, a: &CsrMatrix, keys: Option<&[u32]>, singular: bool) -> bool {
         let stale = keys.is_none()
             || self.factor.is_none()
             || self.age >= self.refresh
@@ -246,7 +246,7 @@ impl CoarseSpace {
     }
 
     /// Aggregates the rows of `a`, assembles `A_c` and factorises it.
-    fn rebuild(&mut self, a: &PpeMatrix, singular: bool) {
+    fn rebuild(&mut self, a: &CsrMatrix, singular: bool) {
         let n = a.n();
         self.grounded = singular;
         let of_row = &mut self.of_row;
@@ -512,5 +512,242 @@ impl Preconditioner for TwoLevel<'_> {
                 *zi = di * ri + if g == NONE { 0.0 } else { coarse[g as usize] };
             },
         );
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::testing::{strip, strip_with_inlet_links};
+    use crate::linalg::{LinearSolver, Method, PreconditionerKind, SolverParams};
+
+    /// On a long strip (400 × 8, like a channel) the two-level preconditioner gives the
+    /// Jacobi solution in a fraction of the iterations.
+    #[test]
+    fn two_level_preconditioner_cuts_the_iterations_of_a_long_strip() {
+        let a = strip(400, 8);
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
+        let solve = |preconditioner, solver| {
+            let opts = SolverParams {
+                method: solver,
+                tolerance: 1e-10,
+                max_iterations: 20_000,
+                preconditioner,
+                coarse_refresh: 1,
+            };
+            let mut p = vec![0.0; n];
+            let info = LinearSolver::new(opts).solve(&a, &b, &mut p, false).expect("converges");
+            (p, info.iterations)
+        };
+        for solver in [Method::Cg, Method::Bicgstab] {
+            let (pj, jacobi) = solve(PreconditionerKind::Jacobi, solver);
+            let (pt, two) = solve(PreconditionerKind::TwoLevel, solver);
+            let err = pj.iter().zip(&pt).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            let scale = pj.iter().map(|x| x.abs()).fold(0.0, f64::max);
+            assert!(err < 1e-7 * scale, "{solver:?}: {err} vs {scale}");
+            assert!(2 * two < jacobi, "{solver:?}: two-level {two} iterations, Jacobi {jacobi}");
+        }
+    }
+
+    /// The two-level solve of `a` (CG) with the given keys on solver `s`; returns the
+    /// iterations.
+    fn keyed_cg(
+        s: &mut LinearSolver,
+        a: &CsrMatrix,
+        b: &[f64],
+        keys: &[u32],
+        singular: bool,
+    ) -> (Vec<f64>, usize) {
+        let mut p = vec![0.0; a.n()];
+        let info = s.solve_keyed(a, b, &mut p, singular, Some(keys)).expect("converges");
+        (p, info.iterations)
+    }
+
+    fn two_level_cg(refresh: usize) -> LinearSolver {
+        LinearSolver::new(SolverParams {
+            method: Method::Cg,
+            tolerance: 1e-10,
+            max_iterations: 20_000,
+            preconditioner: PreconditionerKind::TwoLevel,
+            coarse_refresh: refresh,
+        })
+    }
+
+    /// The coarse space is kept between solves and follows the rows by their keys: a
+    /// renumbered system with its keys renumbered alike is solved with the same
+    /// preconditioner; rows whose keys it has never seen get Jacobi alone until the
+    /// rebuild that `coarse_refresh` schedules.
+    #[test]
+    fn coarse_space_follows_the_keys_and_is_rebuilt_on_schedule() {
+        let a = strip(200, 8);
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
+        let keys: Vec<u32> = (0..n as u32).collect();
+        let mut s = two_level_cg(3);
+        let (p0, fresh) = keyed_cg(&mut s, &a, &b, &keys, false);
+        // The same system renumbered (row k of `r` is row perm[k] of `a`).
+        let perm: Vec<usize> = (0..n).map(|k| (k * 37) % n).collect();
+        let mut inv = vec![0; n];
+        for (k, &i) in perm.iter().enumerate() {
+            inv[i] = k;
+        }
+        let mut r = CsrMatrix { row_ptr: vec![0], ..Default::default() };
+        for &i in &perm {
+            for (c, v) in a.row(i) {
+                r.push(inv[c as usize], v);
+            }
+            r.end_row();
+        }
+        let rb: Vec<f64> = perm.iter().map(|&i| b[i]).collect();
+        let rkeys: Vec<u32> = perm.iter().map(|&i| i as u32).collect();
+        let (pr, kept) = keyed_cg(&mut s, &r, &rb, &rkeys, false);
+        assert!(kept.abs_diff(fresh) <= 1, "renumbered: {kept} iterations against {fresh}");
+        let err = perm.iter().enumerate().map(|(k, &i)| (pr[k] - p0[i]).abs()).fold(0.0, f64::max);
+        let scale = p0.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        assert!(err < 1e-7 * scale, "{err} vs {scale}");
+        // Unknown keys: Jacobi alone until the third solve since the rebuild rebuilds.
+        let new_keys: Vec<u32> = (n as u32..2 * n as u32).collect();
+        let (_, jacobi) = keyed_cg(&mut s, &a, &b, &new_keys, false);
+        let (_, rebuilt) = keyed_cg(&mut s, &a, &b, &new_keys, false);
+        assert!(jacobi > 2 * fresh, "unknown keys: {jacobi} iterations against {fresh}");
+        assert_eq!(rebuilt, fresh, "rebuilt on schedule");
+    }
+
+    /// A coarse space that has aged (here: every row's key unseen, so the coarse
+    /// correction is gone) is rebuilt at the next solve once a solve took more than
+    /// twice the iterations of the first solve after the last rebuild (plus 4), long
+    /// before the `coarse_refresh` schedule would.
+    #[test]
+    fn degraded_coarse_space_is_rebuilt_early() {
+        let a = strip(200, 8);
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
+        let keys: Vec<u32> = (0..n as u32).collect();
+        let new_keys: Vec<u32> = (n as u32..2 * n as u32).collect();
+        let mut s = two_level_cg(1000);
+        let (_, fresh) = keyed_cg(&mut s, &a, &b, &keys, false);
+        let (_, jacobi) = keyed_cg(&mut s, &a, &b, &new_keys, false);
+        let (_, rebuilt) = keyed_cg(&mut s, &a, &b, &new_keys, false);
+        assert!(jacobi > 2 * fresh + 4, "unknown keys: {jacobi} iterations against {fresh}");
+        assert_eq!(rebuilt, fresh, "rebuilt after the degraded solve");
+    }
+
+    /// A non-symmetric system (the open channel's PPE) gets an LU coarse factor and the
+    /// two-level BiCGSTAB keeps its advantage over Jacobi; symmetric systems keep the
+    /// Cholesky factor.
+    #[test]
+    fn non_symmetric_system_gets_an_lu_coarse_factor() {
+        let solver = |preconditioner| {
+            LinearSolver::new(SolverParams {
+                method: Method::Bicgstab,
+                tolerance: 1e-10,
+                max_iterations: 20_000,
+                preconditioner,
+                coarse_refresh: 1,
+            })
+        };
+        let symmetric = strip(400, 8);
+        let a = strip_with_inlet_links(400, 8);
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| 1.0 + ((i * 7919) % 97) as f64 / 97.0).collect();
+        let mut p = vec![0.0; n];
+        let mut s = solver(PreconditionerKind::TwoLevel);
+        s.solve(&symmetric, &b, &mut p, false).expect("converges");
+        assert_eq!(s.coarse().factor_kind(), Some(CoarseFactor::Cholesky));
+        let mut pt = vec![0.0; n];
+        let two = s.solve(&a, &b, &mut pt, false).expect("converges").iterations;
+        assert_eq!(s.coarse().factor_kind(), Some(CoarseFactor::Lu));
+        let mut pd = vec![0.0; n];
+        super::super::direct::solve(&a, &b, &mut pd, false).expect("LU solves");
+        let mut pj = vec![0.0; n];
+        let jacobi =
+            solver(PreconditionerKind::Jacobi).solve(&a, &b, &mut pj, false).expect("converges").iterations;
+        let scale = pd.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        for (name, x) in [("two-level", &pt), ("Jacobi", &pj)] {
+            let err = pd.iter().zip(x).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+            assert!(err < 1e-7 * scale, "{name}: {err} vs {scale}");
+        }
+        assert!(3 * two < jacobi, "two-level {two} iterations, Jacobi {jacobi}");
+    }
+
+    /// A system with no Dirichlet row (the periodic channel's PPE) keeps its coarse
+    /// correction: the coarse null space is grounded.
+    #[test]
+    fn two_level_solves_a_singular_system() {
+        // A periodic 400 × 8 strip: the 5-point Laplacian wrapped along the long axis and
+        // with Neumann rows across (rows sum to zero).
+        let (rows, m) = (400, 8);
+        let mut a = CsrMatrix { row_ptr: vec![0], ..Default::default() };
+        for i in 0..rows {
+            for j in 0..m {
+                let k = i * m + j;
+                let mut off = vec![((i + rows - 1) % rows) * m + j, ((i + 1) % rows) * m + j];
+                if j > 0 {
+                    off.push(k - 1);
+                }
+                if j + 1 < m {
+                    off.push(k + 1);
+                }
+                a.push(k, off.len() as f64);
+                for c in off {
+                    a.push(c, -1.0);
+                }
+                a.end_row();
+            }
+        }
+        let n = a.n();
+        let b: Vec<f64> = (0..n).map(|i| (i as f64 * 0.013).sin() + 0.3).collect();
+        let keys: Vec<u32> = (0..n as u32).collect();
+        let mut jacobi = LinearSolver::new(SolverParams {
+            method: Method::Cg,
+            tolerance: 1e-10,
+            max_iterations: 20_000,
+            preconditioner: PreconditionerKind::Jacobi,
+            coarse_refresh: 1,
+        });
+        let mut pj = vec![0.0; n];
+        let j = jacobi.solve(&a, &b, &mut pj, true).expect("Jacobi converges").iterations;
+        let (pt, t) = keyed_cg(&mut two_level_cg(25), &a, &b, &keys, true);
+        let err = pj.iter().zip(&pt).map(|(x, y)| (x - y).abs()).fold(0.0, f64::max);
+        let scale = pj.iter().map(|x| x.abs()).fold(0.0, f64::max);
+        assert!(err < 1e-7 * scale, "{err} vs {scale}");
+        assert!(pt.iter().sum::<f64>().abs() < 1e-8 * scale * n as f64);
+        assert!(2 * t < j, "two-level {t} iterations, Jacobi {j}");
+    }
+
+    /// Every row is in one aggregate; for a symmetric system the factor is Cholesky and
+    /// `M⁻¹` is symmetric (so CG applies); a residual made of coarse modes, `r = A P c`, gets
+    /// its coarse part back exactly: `M⁻¹ r − D⁻¹ r = P c`.
+    #[test]
+    fn the_preconditioner_is_symmetric_and_exact_on_coarse_modes() {
+        let a = strip(60, 6);
+        let n = a.n();
+        let mut space = CoarseSpace::new(5);
+        assert!(space.prepare(&a, None, false));
+        let nc = space.coarse_size();
+        assert!(nc > 1 && nc < n / 3, "{nc} aggregates of {n} rows");
+        assert!(space.of_row.iter().all(|&g| (g as usize) < nc));
+        assert_eq!(space.factor_kind(), Some(CoarseFactor::Cholesky));
+        let m = space.preconditioner(&a.inv_diag);
+        let apply = |r: &[f64]| {
+            let mut z = vec![0.0; n];
+            m.apply(r, &mut z);
+            z
+        };
+        let x: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let y: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos()).collect();
+        let dot = |p: &[f64], q: &[f64]| p.iter().zip(q).map(|(p, q)| p * q).sum::<f64>();
+        let (xy, yx) = (dot(&x, &apply(&y)), dot(&y, &apply(&x)));
+        assert!((xy - yx).abs() <= 1e-12 * xy.abs().max(1.0), "{xy} vs {yx}");
+        let c: Vec<f64> = (0..nc).map(|g| 1.0 + (g % 5) as f64).collect();
+        let pc: Vec<f64> = space.of_row.iter().map(|&g| c[g as usize]).collect();
+        let mut r = vec![0.0; n];
+        a.mul(&pc, &mut r);
+        let z = apply(&r);
+        for i in 0..n {
+            let coarse = z[i] - a.inv_diag[i] * r[i];
+            assert!((coarse - pc[i]).abs() < 1e-9 * pc[i].abs(), "row {i}: {coarse} vs {}", pc[i]);
+        }
     }
 }

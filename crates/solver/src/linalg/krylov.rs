@@ -1,6 +1,5 @@
-//! Preconditioned conjugate gradient and BiCGSTAB for the PPE (and the implicit viscous
-//! system), with parallel vector operations whose results do not depend on the thread
-//! count.
+//! Preconditioned conjugate gradient and BiCGSTAB over any [`RowOperator`], with parallel
+//! vector operations whose results do not depend on the thread count.
 //!
 //! Why not faer's `matrix_free` solvers, which the solver used before: with `Par::Seq`
 //! their vector updates and dot products run on one thread, and the solve became the part
@@ -27,7 +26,7 @@
 //! (BiCGSTAB, right preconditioned). Both stop when the recursively updated residual
 //! satisfies `‖r‖ ≤ tol ‖b‖`; the caller measures the true residual afterwards.
 
-use crate::ppe::PpeMatrix;
+use super::RowOperator;
 use rayon::prelude::*;
 
 /// Entries per block of a reduction: the unit of parallel work and of the fixed
@@ -197,7 +196,7 @@ fn update_preconditioned(
 /// thread three of the four (the solve measured 1.5 times slower than row-parallel); each
 /// block then sums its rows in order, so the sums are still the same bits.
 fn mul_reduce(
-    a: &PpeMatrix,
+    a: &impl RowOperator,
     x: &[f64],
     y: &mut [f64],
     partials: &mut [[f64; 2]],
@@ -226,7 +225,7 @@ fn usable(value: f64, what: &'static str) -> Result<f64, KrylovError> {
 }
 
 /// `‖b‖`, and `r = b − A x` with `‖r‖²`.
-fn start(a: &PpeMatrix, b: &[f64], x: &[f64], ws: &mut Workspace) -> (f64, f64) {
+fn start(a: &impl RowOperator, b: &[f64], x: &[f64], ws: &mut Workspace) -> (f64, f64) {
     let n = b.len();
     ws.resize(n);
     let b_norm = reduce(n, &mut ws.partials, |i| [b[i] * b[i], 0.0])[0].sqrt();
@@ -237,7 +236,7 @@ fn start(a: &PpeMatrix, b: &[f64], x: &[f64], ws: &mut Workspace) -> (f64, f64) 
 /// Preconditioned conjugate gradient (Saad Alg. 9.1) for symmetric positive (semi-)definite
 /// `A`: solves `A x = b` from the initial guess in `x`; returns the iterations taken.
 pub fn conjugate_gradient(
-    a: &PpeMatrix,
+    a: &impl RowOperator,
     m: &impl Preconditioner,
     b: &[f64],
     x: &mut [f64],
@@ -302,7 +301,7 @@ pub fn conjugate_gradient(
 /// BiCGSTAB with right preconditioning (van der Vorst 1992; *Templates* §2.3.8): solves
 /// `A x = b` from the initial guess in `x`; returns the iterations taken.
 pub fn bicgstab(
-    a: &PpeMatrix,
+    a: &impl RowOperator,
     m: &impl Preconditioner,
     b: &[f64],
     x: &mut [f64],
@@ -382,11 +381,12 @@ pub fn bicgstab(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::linalg::CsrMatrix;
 
     /// 5-point Laplacian on an m×m grid (Dirichlet boundary) plus `skew` times a centred
     /// first difference along x (non-symmetric for `skew ≠ 0`).
-    fn operator(m: usize, skew: f64) -> PpeMatrix {
-        let mut a = PpeMatrix { row_ptr: vec![0], ..Default::default() };
+    fn operator(m: usize, skew: f64) -> CsrMatrix {
+        let mut a = CsrMatrix { row_ptr: vec![0], ..Default::default() };
         for i in 0..m {
             for j in 0..m {
                 let k = i * m + j;
@@ -415,7 +415,7 @@ mod tests {
     }
 
     type Solver = fn(
-        &PpeMatrix,
+        &CsrMatrix,
         &Jacobi<'_>,
         &[f64],
         &mut [f64],
@@ -424,7 +424,7 @@ mod tests {
     ) -> Result<usize, KrylovError>;
 
     fn cg(
-        a: &PpeMatrix,
+        a: &CsrMatrix,
         m: &Jacobi<'_>,
         b: &[f64],
         x: &mut [f64],
@@ -435,7 +435,7 @@ mod tests {
     }
 
     fn bi(
-        a: &PpeMatrix,
+        a: &CsrMatrix,
         m: &Jacobi<'_>,
         b: &[f64],
         x: &mut [f64],
@@ -445,7 +445,7 @@ mod tests {
         bicgstab(a, m, b, x, p, w)
     }
 
-    fn solve_with(threads: usize, a: &PpeMatrix, solver: Solver) -> (Vec<f64>, usize) {
+    fn solve_with(threads: usize, a: &CsrMatrix, solver: Solver) -> (Vec<f64>, usize) {
         let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().expect("a thread pool");
         pool.install(|| {
             let b: Vec<f64> = (0..a.n()).map(|i| ((i * 7919) % 101) as f64 / 101.0 - 0.4).collect();

@@ -1,0 +1,57 @@
+//! The pressure Poisson system of the projection (Qiu 2013 eqs. 5, 10, 12) as the scheme
+//! holds it between its assembly and its solve, and the mapping of the scene's
+//! `scheme.isph.ppe` options onto the linear solver ([`crate::linalg`]).
+
+use crate::error::Cause;
+use crate::linalg::{CsrMatrix, Method, PreconditionerKind, SolveError, SolverParams};
+use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
+
+/// The PPE of the current step: matrix, right-hand side and the particle ↔ row maps.
+#[derive(Debug, Clone, Default)]
+pub struct PpeSystem {
+    /// Matrix over the rows of non-free-surface particles.
+    pub matrix: CsrMatrix,
+    /// Right-hand side `−div u* / Δt` \[Pa/m² per kg/m³\].
+    pub rhs: Vec<f64>,
+    /// (diagonal, right-hand side) of each row as the assembly's pair pass leaves them.
+    pub row_out: Vec<[f64; 2]>,
+    /// Row of each particle (`u32::MAX` for particles whose pressure is known).
+    pub row_of: Vec<u32>,
+    /// Particle of each row.
+    pub particle_of: Vec<u32>,
+    /// Id of each row's particle (the key of the two-level preconditioner's coarse space;
+    /// filled only when that preconditioner is configured).
+    pub row_key: Vec<u32>,
+    /// Unknowns (pressures of the rows) \[Pa\].
+    pub solution: Vec<f64>,
+    /// True when no row is Dirichlet-constrained (closed or periodic domain).
+    pub singular: bool,
+}
+
+/// The linear solver settings of the scene's PPE options.
+pub fn solver_params(opts: &PpeOptions) -> SolverParams {
+    SolverParams {
+        method: match opts.solver {
+            PpeSolver::Cg => Method::Cg,
+            PpeSolver::Bicgstab => Method::Bicgstab,
+            PpeSolver::Direct => Method::Direct,
+        },
+        tolerance: opts.tolerance,
+        max_iterations: opts.max_iterations,
+        preconditioner: match opts.preconditioner {
+            Preconditioner::Jacobi => PreconditionerKind::Jacobi,
+            Preconditioner::TwoLevel => PreconditionerKind::TwoLevel,
+        },
+        coarse_refresh: opts.coarse_refresh,
+    }
+}
+
+/// The run's failure cause of a failed pressure (or viscous) solve.
+pub fn cause(e: SolveError) -> Cause {
+    match e {
+        SolveError::NoConvergence { method, residual, iterations } => {
+            Cause::PpeNoConvergence { solver: method, residual, iterations }
+        }
+        SolveError::Breakdown { method, reason } => Cause::PpeBreakdown { solver: method, reason },
+    }
+}
