@@ -252,7 +252,9 @@ impl<const D: usize> Columns<D> {
         fields.visit(&mut |field| {
             let n = match extent {
                 Extent::All => usize::MAX,
-                Extent::Output(_) if field.output.is_none() && !matches!(field.column, ColumnRef::Ids(_)) => 0,
+                Extent::Output(_) if field.output.is_none() && !matches!(field.column, ColumnRef::Ids(_)) => {
+                    0
+                }
                 Extent::Output(n) => n,
             };
             match field.column {

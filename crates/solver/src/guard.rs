@@ -249,7 +249,8 @@ mod tests {
         let ctx = StepContext { step: 1, time: 0.0, dt: 1e-5 };
         search_neighbours(&mut sim, &ctx).expect("neighbour search");
         let n = sim.state().particles.len();
-        let at = |sim: &Simulation<2>, id: u32| sim.state().particles.id.iter().position(|&i| i == id).unwrap();
+        let at =
+            |sim: &Simulation<2>, id: u32| sim.state().particles.id.iter().position(|&i| i == id).unwrap();
         let (a, b, c) = (at(&sim, 7), at(&sim, 3), at(&sim, (n - 1) as u32));
         sim.method_mut().state_mut().particles.x[a][0] = 1e6;
         sim.method_mut().state_mut().particles.x[b][1] = -1e6;

@@ -11,6 +11,7 @@
 //! to its implementation) and steps it to the end time, returning a [`run::RunReport`]
 //! with `summary.json` and `probes.json` content. Units are SI throughout.
 
+pub mod boundary_map;
 pub mod error;
 pub mod fields;
 pub mod frame;
@@ -35,7 +36,7 @@ pub mod warm_pool;
 pub mod wcsph;
 
 pub use error::{Cause, SceneError, SolverError};
-pub use probes::ProbeRecord;
 pub use frame::Frame;
+pub use probes::ProbeRecord;
 pub use run::{AnySimulation, Observer, Quiet, RunReport, Status, Summary, run};
 pub use scene::Scene;

@@ -49,7 +49,13 @@ impl ShaoLo {
 /// The velocity divergence at particle `a` in the difference form of Qiu 2013 eq. 10,
 /// `V Σ_b (u_b − u_a)·∇_aW_ab`, over `a`'s `pairs` and neighbours `nbrs`.
 #[inline]
-pub fn divergence<const D: usize>(u: &[Vector<D>], a: usize, pairs: &[Pair<D>], nbrs: &[u32], volume: f64) -> f64 {
+pub fn divergence<const D: usize>(
+    u: &[Vector<D>],
+    a: usize,
+    pairs: &[Pair<D>],
+    nbrs: &[u32],
+    volume: f64,
+) -> f64 {
     let mut div = 0.0;
     for (p, &b) in pairs.iter().zip(nbrs) {
         div += (u[b as usize] - u[a]).dot(&p.r_ab) * p.f;

@@ -199,7 +199,11 @@ impl<const D: usize> ProbeSet<D> {
                     out.push(key, "r_max", r_max);
                 }
                 Probe::Solver {} => {
-                    out.push(key, "free_surface_count", s.particles.free_surface.iter().filter(|&&f| f).count() as f64);
+                    out.push(
+                        key,
+                        "free_surface_count",
+                        s.particles.free_surface.iter().filter(|&&f| f).count() as f64,
+                    );
                     out.push(key, "iterations", s.solve.iterations as f64);
                     // Measured whenever the scene has this probe (the run driver asks for it).
                     out.push(key, "residual", s.solve.residual.unwrap_or(f64::NAN));

@@ -119,7 +119,12 @@ impl<const D: usize> Stepper<D> {
     /// Runs stage `i` of the step described by `ctx`; panics if `i >= stage_count()`.
     pub fn run_stage(&mut self, i: usize, ctx: &StepContext) -> Result<(), SolverError> {
         let m = self.sim.method_mut();
-        m.run_stage(i, ctx).map_err(|cause| SolverError { stage: m.stage_name(i), step: ctx.step, time: ctx.time, cause })
+        m.run_stage(i, ctx).map_err(|cause| SolverError {
+            stage: m.stage_name(i),
+            step: ctx.step,
+            time: ctx.time,
+            cause,
+        })
     }
 
     /// Runs stages `0..end` of the step described by `ctx` (prepares the input of stage

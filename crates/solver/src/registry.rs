@@ -39,5 +39,9 @@ pub fn compose_with<const D: usize, S: Scheme<D>>(scene: &Scene) -> Result<Built
 fn with_kernel<const D: usize, S: Scheme<D>, K: Kernel>(scene: &Scene) -> Result<Built<D>, SceneError> {
     let kernel = Scaled::<K, D>::new(scene.h());
     let method = Box::new(S::build(scene, kernel)?);
-    Ok(Built { method, weight: Weight { w: Box::new(move |r| kernel.w(r)), support: kernel.support }, support: kernel.support })
+    Ok(Built {
+        method,
+        weight: Weight { w: Box::new(move |r| kernel.w(r)), support: kernel.support },
+        support: kernel.support,
+    })
 }

@@ -344,7 +344,12 @@ impl<const D: usize> Simulation<D> {
             let r = self.method.run_stage(i, ctx);
             *time += s0.elapsed().as_secs_f64();
             if let Err(cause) = r {
-                return Err(SolverError { stage: self.method.stage_name(i), step: ctx.step, time: ctx.time, cause });
+                return Err(SolverError {
+                    stage: self.method.stage_name(i),
+                    step: ctx.step,
+                    time: ctx.time,
+                    cause,
+                });
             }
         }
         let s0 = Instant::now();

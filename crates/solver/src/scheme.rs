@@ -10,7 +10,7 @@
 //! beside its material points) keeps it in `Own`.
 
 use crate::error::{Cause, SceneError};
-use crate::fields::{Columns, ColumnRef, Extent, Field, Fields};
+use crate::fields::{ColumnRef, Columns, Extent, Field, Fields};
 use crate::kernel::{Kernel, Scaled};
 use crate::scene::Scene;
 use crate::stage::{Stage, StepContext};

@@ -3,74 +3,32 @@
 //! periodic axes, the open boundaries' buffers, dummy wall layers; and the shared
 //! [`State`] around them.
 
-use crate::error::SceneError;
-use crate::neighbours::Domain;
-use crate::scene::{Role, Scene, WallModel, lattice};
+use crate::scene::{Scene, WallModel, seeding};
 use crate::stages::dummy::dummy_layers;
 use crate::stages::open_boundary::{OpenSetup, Openings};
 use crate::state::{Particles, State, Vector};
 
-/// The initial state of `scene` for a kernel of `support` \[m\] and smoothing length `h`
-/// \[m\], and its open boundaries when it has an inflow and an outflow.
-pub fn particle_state<const D: usize>(
-    scene: &Scene,
-    h: f64,
-    support: f64,
-) -> Result<(State<D>, Option<OpenSetup>), SceneError> {
-    let g = Vector::<D>::from_fn(|i, _| scene.body_force.get(i).copied().unwrap_or(0.0));
-    let mut particles = Particles::<D>::default();
-    let mut body_start = Vec::with_capacity(scene.bodies.len());
-    for (i, body) in scene.bodies.iter().enumerate() {
-        body_start.push(particles.x.len());
-        if body.role == Role::Wall {
-            return Err(SceneError::new(
-                format!("bodies[{i}].role"),
-                "wall",
-                "wall bodies are not supported yet by the ISPH runner",
-            ));
-        }
-        for seed in lattice::seed_body::<D>(body, scene.dx, scene.fluid.density, &g) {
-            particles.fluid += 1;
-            particles.id.push(particles.x.len() as u32);
-            particles.x.push(seed.x);
-            particles.u.push(seed.u);
-            particles.p.push(seed.p);
-        }
-    }
-    if particles.is_empty() {
-        return Err(SceneError::new("bodies", scene.bodies.len(), "hold no particle"));
-    }
-    for (i, wall) in scene.boundaries.walls.iter().enumerate() {
-        let side = if wall.fluid_side == crate::scene::Side::Above { 1.0 } else { -1.0 };
-        if let Some(x) = particles.x.iter().find(|x| side * (x[wall.axis] - wall.position) <= 0.0) {
-            return Err(SceneError::new(
-                format!("boundaries.walls[{i}].position"),
-                wall.position,
-                format!("leaves fluid particles behind the wall (one at {:?})", x.as_slice()),
-            ));
-        }
-    }
-    let mut domain = Domain::<D>::default();
-    for axis in &scene.boundaries.periodic {
-        domain.periodic[axis.axis] = Some((axis.min, axis.max));
-    }
-    for x in &mut particles.x {
-        domain.wrap(x);
-    }
-    check_seeds(&particles, &body_start, scene.dx, domain)?;
-    for (i, body) in scene.bodies.iter().enumerate() {
-        if let Some(jitter) = &body.jitter {
-            let end = body_start.get(i + 1).copied().unwrap_or(particles.fluid);
-            lattice::apply_jitter(&mut particles.x[body_start[i]..end], scene.dx, jitter);
-        }
-    }
-    for x in &mut particles.x {
-        domain.wrap(x);
-    }
+/// The initial state of a (validated) `scene` for a kernel of `support` \[m\] and
+/// smoothing length `h` \[m\], and its open boundaries when it has an inflow and an
+/// outflow. The scene rules on the seeded particles are the validation's
+/// ([`crate::scene::validate`]), so building a validated scene cannot fail.
+pub fn particle_state<const D: usize>(scene: &Scene, h: f64, support: f64) -> (State<D>, Option<OpenSetup>) {
+    let mut seeds = seeding::seed_bodies::<D>(scene);
+    seeding::jitter(scene, &mut seeds);
+    let domain = seeding::domain::<D>(scene);
+    let fluid = seeds.x.len();
+    let mut particles = Particles::<D> {
+        fluid,
+        id: (0..fluid as u32).collect(),
+        x: seeds.x,
+        u: seeds.u,
+        p: seeds.p,
+        ..Default::default()
+    };
     let open = match (&scene.boundaries.inflow, &scene.boundaries.outflow) {
         (Some(i), Some(o)) => {
             let openings = Openings::new(i, o, scene.dx, support);
-            let (inlet, link) = openings.seed(&mut particles)?;
+            let (inlet, link) = openings.seed(&mut particles);
             Some(OpenSetup { openings, inlet, next_id: particles.fluid as u32, link })
         }
         _ => None,
@@ -102,61 +60,8 @@ pub fn particle_state<const D: usize>(
         buffer,
         flux: Default::default(),
         inlet: open.as_ref().map(|o| o.link.clone()).unwrap_or_default(),
+        links: Default::default(),
         solve: Default::default(),
     };
-    Ok((state, open))
+    (state, open)
 }
-
-/// Rejects initial particles that cannot be run: a non-finite initial velocity or pressure
-/// (an affine or quadratic field overflowing), and particles closer than Δx/2 to each other
-/// (overlapping bodies). `body_start[i]` is the index of body i's first particle.
-fn check_seeds<const D: usize>(
-    p: &Particles<D>,
-    body_start: &[usize],
-    dx: f64,
-    domain: Domain<D>,
-) -> Result<(), SceneError> {
-    let body_of = |a: usize| body_start.partition_point(|&s| s <= a).saturating_sub(1);
-    let show = |v: &Vector<D>| {
-        let parts: Vec<String> = v.iter().map(|x| format!("{x:.4e}")).collect();
-        format!("({})", parts.join(", "))
-    };
-    if let Some(a) = (0..p.len()).find(|&a| !p.u[a].iter().all(|v| v.is_finite())) {
-        return Err(SceneError::new(
-            format!("bodies[{}].velocity", body_of(a)),
-            format!("u = {} at x = {}", show(&p.u[a]), show(&p.x[a])),
-            "must give a finite initial velocity at every particle",
-        ));
-    }
-    if let Some(a) = (0..p.len()).find(|&a| !p.p[a].is_finite()) {
-        return Err(SceneError::new(
-            format!("bodies[{}].pressure", body_of(a)),
-            format!("p = {} at x = {}", p.p[a], show(&p.x[a])),
-            "must give a finite initial pressure at every particle",
-        ));
-    }
-    let mut list = crate::neighbours::NeighbourList::default();
-    crate::neighbours::CellSearch::new(0.5 * dx, domain).build(&p.x, &mut list);
-    let close = (0..p.len()).flat_map(|a| list.of(a).iter().map(move |&b| (a, b as usize)));
-    // The pair whose later body comes first: that body is the one that overlaps.
-    if let Some((a, b)) = close.min_by_key(|&(a, b)| (body_of(a.max(b)), a.max(b), a.min(b))) {
-        let (i, j) = (body_of(a.max(b)), body_of(a.min(b)));
-        let x = show(&p.x[a.max(b)]);
-        return Err(if i == j {
-            SceneError::new(
-                format!("bodies[{i}].shape"),
-                format!("particles at {x}"),
-                "places particles closer than dx/2 to each other (the shape wraps onto itself \
-                 across a periodic boundary)",
-            )
-        } else {
-            SceneError::new(
-                format!("bodies[{i}].shape"),
-                format!("a particle at {x}"),
-                format!("overlaps bodies[{j}] (particles closer than dx/2); bodies must not overlap"),
-            )
-        });
-    }
-    Ok(())
-}
-

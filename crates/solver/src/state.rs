@@ -112,6 +112,9 @@ pub struct State<const D: usize> {
     pub flux: Flux,
     /// Where the inlet buffer takes its pressure from.
     pub inlet: InletLink,
+    /// What each boundary particle's pressure and velocity are to the implicit systems
+    /// (rebuilt every step by the `boundary_links` stage of a scene with boundaries).
+    pub links: crate::boundary_map::BoundaryMap,
     /// Iterations and residual of the step's pressure solve (none for explicit schemes).
     pub solve: crate::linalg::SolveInfo,
 }

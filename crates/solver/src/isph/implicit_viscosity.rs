@@ -12,8 +12,11 @@
 //! its source's unknown with the factor σ; a dummy wall particle's velocity (extrapolated
 //! from `uⁿ`) is known and moves to the right-hand side.
 
+use crate::boundary_map::Link;
 use crate::error::Cause;
-use crate::linalg::{CsrMatrix, LinearSolver, Method, PreconditionerKind, SolverParams, par_csr_rows_mut, stored};
+use crate::linalg::{
+    CsrMatrix, LinearSolver, Method, PreconditionerKind, SolverParams, par_csr_rows_mut, stored,
+};
 use crate::operators::ShaoLo;
 use crate::stage::{Stage, StepContext};
 use crate::state::State;
@@ -61,16 +64,14 @@ impl<const D: usize, O> Stage<D, O> for ImplicitViscosity {
         let n = s.particles.fluid;
         let (list, pairs) = (&s.neighbours, &s.pairs);
         let (shao_lo, c) = (ShaoLo::new(s.h), ctx.dt * self.nu * 2.0 * s.volume);
-        let (source, sign, start) = (&s.mirrors.source, &s.mirrors.sign, s.walls_start());
+        let links = &s.links;
         // The unknown a neighbour couples to, with its factor (None: a known value, as for
         // open-boundary buffers, dummy wall particles and the mirrors of buffers).
         let column = |b: usize| -> Option<(u32, f64)> {
-            if b < n {
-                Some((b as u32, 1.0))
-            } else if b < start {
-                None
-            } else {
-                source.get(b - start).filter(|&&src| (src as usize) < n).map(|&src| (src, sign[b - start]))
+            match links.velocity(b) {
+                Link::Unknown => Some((b as u32, 1.0)),
+                Link::Shares { source, sign } if (source as usize) < n => Some((source, sign)),
+                Link::Shares { .. } | Link::Known => None,
             }
         };
         let m = &mut self.matrix;

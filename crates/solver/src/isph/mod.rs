@@ -3,7 +3,8 @@
 //! The step, built from the scene (a stage the scene does not need is not built):
 //! `reorder` (locality) → `advect` (eq. 3) → `walls` (§2.4.2; mirror walls only) →
 //! `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation) →
-//! `inlet_sources` (inflow only) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
+//! `inlet_sources` (inflow only) → `boundary_links` (walls or open boundaries: the
+//! boundary map) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
 //! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) or `surface_pressure`
 //! (σ > 0, `young_laplace`: p = σκ on the free surface) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
 //! `mirror_velocity` | `dummy_velocity` (walls only) → `particle_density` (density
@@ -35,6 +36,7 @@ use crate::scene::{IsphOptions, Probe, Scene, Scheme as SceneScheme};
 use crate::scene::{ViscousIntegration, ViscousOperator, WallModel};
 use crate::scheme::{Adaptive, Composed, Scheme};
 use crate::stage::{Stage, StepContext};
+use crate::stages::boundary_links::BoundaryLinks;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
@@ -84,7 +86,7 @@ impl<const D: usize> Scheme<D> for Isph {
         let SceneScheme::Isph(opts) = &scene.scheme else {
             return Err(SceneError::new("scheme", "not isph", "must be `isph` for the projection scheme"));
         };
-        let (state, open) = crate::setup::particle_state::<D>(scene, kernel.h, kernel.support)?;
+        let (state, open) = crate::setup::particle_state::<D>(scene, kernel.h, kernel.support);
         let explicit = opts.viscosity == ViscousIntegration::Explicit;
         // The Monaghan–Cleary operator acts along r̂_ab with weight 2(D+2) against
         // Shao–Lo's 2 on all components: its largest eigenvalue is (D+2)/D times larger,
@@ -152,6 +154,9 @@ fn build_stages<K: Kernel, const D: usize>(
     }
     if open.is_some() {
         stages.push(Box::new(InletSources));
+    }
+    if walls.is_some() || open.is_some() {
+        stages.push(Box::new(BoundaryLinks));
     }
     stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold }));
     // Explicit: u* = uⁿ + Δt ν L(uⁿ), then + Δt g. Implicit: uⁿ + Δt g first, then the

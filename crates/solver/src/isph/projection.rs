@@ -1,8 +1,9 @@
 //! Projection stages (Qiu 2013 §2.2–2.3, eqs. 5–7, 10, 12, 15): PPE assembly and solve,
 //! velocity correction, position update.
 
-use crate::error::Cause;
 use super::IsphData;
+use crate::boundary_map::Link;
+use crate::error::Cause;
 use crate::linalg::{LinearSolver, par_csr_rows_mut, stored};
 use crate::operators::{ShaoLo, corrected_divergence, divergence, moment};
 use crate::scene::{Divergence, PressureGradient};
@@ -57,23 +58,18 @@ impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
                 sys.particle_of.push(a as u32);
             }
         }
-        // A mirror's pressure is its source's: it shares the source's unknown. Other
-        // boundary particles (dummy walls) carry known pressures.
-        // Open-boundary buffers carry known pressures too; a buffer's mirror gets no row.
-        sys.row_of[n..].fill(u32::MAX);
-        // An inlet buffer particle shares its source's unknown (zero normal gradient).
-        for (i, &src) in s.inlet.source.iter().enumerate() {
-            if src != u32::MAX {
-                sys.row_of[n + i] = sys.row_of[src as usize];
-            }
-        }
-        let start = n + s.buffer;
-        for (k, &src) in s.mirrors.source.iter().enumerate() {
-            sys.row_of[start + k] = sys.row_of[src as usize];
+        // Boundary particles by the boundary map: a mirror shares its source's unknown, an
+        // inlet buffer particle its row source's (zero normal gradient); dummy walls and the
+        // outlet buffer carry known pressures (boundary particles come in index order, so a
+        // mirror of a buffer particle finds the buffer's row set).
+        for b in n..s.particles.total() {
+            sys.row_of[b] = match s.links.pressure(b) {
+                Link::Shares { source, .. } => sys.row_of[source as usize],
+                Link::Unknown | Link::Known => u32::MAX,
+            };
         }
         let rows = sys.particle_of.len();
-        let linked = s.inlet.source.iter().filter(|&&src| src != u32::MAX).count();
-        let known_boundary = s.particles.total() > n + linked + s.mirrors.source.len();
+        let known_boundary = s.links.has_known_pressure();
         sys.singular = rows == n && !known_boundary;
         let (list, row_of, particle_of) = (&s.neighbours, &sys.row_of, &sys.particle_of);
         // Row lengths: the interior neighbours (the diagonal is stored apart).
@@ -210,15 +206,10 @@ impl<const D: usize> Stage<D, IsphData> for PpeSolveStage {
         for (x, &a) in sys.solution.iter().zip(&sys.particle_of) {
             p[a as usize] = *x;
         }
-        let nf = s.particles.fluid;
-        for (i, &src) in s.inlet.source.iter().enumerate() {
-            if src != u32::MAX {
-                p[nf + i] = p[src as usize];
-            }
-        }
-        let (fluid, mirrors) = p.split_at_mut(nf + s.buffer);
-        for (pm, &src) in mirrors.iter_mut().zip(&s.mirrors.source) {
-            *pm = fluid[src as usize];
+        // Boundary particles sharing an unknown take its value (in index order: a mirror of
+        // an inlet buffer particle after the buffer particle).
+        for (b, source) in s.links.pressure_copies() {
+            p[b] = p[source as usize];
         }
         Ok(())
     }

@@ -1,10 +1,13 @@
-//! Scene files: schema ([`schema`]), value checks ([`validate()`]) and particle
-//! generation on the cell-centred lattice ([`lattice`]).
+//! Scene files: schema ([`schema`]), every scene rule ([`validate()`], including those on
+//! the seeded particles) and particle generation on the cell-centred lattice
+//! ([`lattice`], [`seeding`]).
 
 pub mod lattice;
 pub mod schema;
+pub mod seeding;
 mod validate;
 mod validate_boundaries;
+mod validate_seeds;
 
 pub use schema::*;
 pub use validate::validate;

@@ -1,9 +1,10 @@
-//! Value checks of a parsed scene: every rule names the field, the value and the rule.
+//! Every rule of a parsed scene (the seeded particles' in [`super::validate_seeds`]): each
+//! names the field, the value and the rule. Building a scene that passes cannot fail.
 
 use super::schema::*;
 use crate::error::SceneError;
 
-/// Checks every value of `scene`; the first violation is returned.
+/// Checks every rule of `scene`; the first violation is returned.
 pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     let d = scene.dimension;
     if d != 2 && d != 3 {
@@ -158,7 +159,9 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     if scene.output.probe_every == 0 {
         return Err(SceneError::new("output.probe_every", 0, "must be at least 1"));
     }
-    super::validate_boundaries::validate(scene)
+    super::validate_boundaries::validate(scene)?;
+    // Last: the rules on the seeded particles, which the ones above make safe to seed.
+    super::validate_seeds::validate_seeds(scene)
 }
 
 /// Largest particle count a scene may ask for (memory: about 1 kB per particle).

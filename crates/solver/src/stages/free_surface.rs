@@ -26,7 +26,12 @@ impl<const D: usize, O> Stage<D, O> for FreeSurface {
         s.particles.div_r.resize(n, 0.0);
         s.particles.free_surface.resize(n, false);
         let t = self.threshold;
-        s.particles.free_surface.par_iter_mut().zip(&s.particles.div_r).with_min_len(1024).for_each(|(fs, d)| *fs = *d < t);
+        s.particles
+            .free_surface
+            .par_iter_mut()
+            .zip(&s.particles.div_r)
+            .with_min_len(1024)
+            .for_each(|(fs, d)| *fs = *d < t);
         Ok(())
     }
 }

@@ -2,6 +2,7 @@
 //! boundaries (inflow/outflow buffers), neighbour search with the pair cache, free-surface
 //! detection, surface tension (forces, or the Young–Laplace free-surface pressure).
 
+pub mod boundary_links;
 pub mod dummy;
 pub mod free_surface;
 pub mod neighbours;

@@ -59,17 +59,22 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Neighbours<K, D> {
         let (x, list, dom, k, v, div_r) =
             (&s.particles.x, &s.neighbours, s.domain, self.kernel, s.volume, self.div_r);
         s.particles.div_r.resize(rows, 0.0);
-        par_rows_mut(&list.offsets, &mut s.pairs, &mut s.particles.div_r, &|a, row: &mut [Pair<D>], d: &mut f64| {
-            for (pair, &b) in row.iter_mut().zip(list.of(a)) {
-                let r_ab = dom.displacement(&x[a], &x[b as usize]);
-                let r2 = r_ab.norm_squared();
-                *pair = Pair { r_ab, f: k.grad_factor(r2.sqrt()) };
-            }
-            if div_r {
-                // r_ab · ∇_a W_ab = f r².
-                *d = -v * row.iter().map(|p| p.f * p.r2()).sum::<f64>();
-            }
-        });
+        par_rows_mut(
+            &list.offsets,
+            &mut s.pairs,
+            &mut s.particles.div_r,
+            &|a, row: &mut [Pair<D>], d: &mut f64| {
+                for (pair, &b) in row.iter_mut().zip(list.of(a)) {
+                    let r_ab = dom.displacement(&x[a], &x[b as usize]);
+                    let r2 = r_ab.norm_squared();
+                    *pair = Pair { r_ab, f: k.grad_factor(r2.sqrt()) };
+                }
+                if div_r {
+                    // r_ab · ∇_a W_ab = f r².
+                    *d = -v * row.iter().map(|p| p.f * p.r2()).sum::<f64>();
+                }
+            },
+        );
         Ok(())
     }
 }

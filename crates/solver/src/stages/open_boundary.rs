@@ -19,7 +19,7 @@
 //! neither free-surface particles nor short of neighbours. The masses that crossed are
 //! counted in [`crate::state::Flux`] (the `mass_balance` probe).
 
-use crate::error::{Cause, SceneError};
+use crate::error::Cause;
 use crate::fields::{Fields, retain};
 use crate::scene::{Inflow, Outflow};
 use crate::stage::{Stage, StepContext};
@@ -63,31 +63,14 @@ impl Openings {
 
     /// Appends the initial buffers after the fluid of `p` (inlet buffer first) and returns
     /// the number of inlet buffer particles with their pressure link (each row's source is
-    /// at first the fluid particle of the first column). The fluid must span the channel:
-    /// no particle upstream of the inlet or downstream of the outlet, and a lattice column
-    /// within Δx of each plane (else the error names the plane's field).
-    pub fn seed<const D: usize>(&self, p: &mut Particles<D>) -> Result<(usize, InletLink), SceneError> {
+    /// at first the fluid particle of the first column). The fluid spans the channel, with
+    /// a lattice column within Δx of each plane (a scene rule, checked by the validation).
+    pub fn seed<const D: usize>(&self, p: &mut Particles<D>) -> (usize, InletLink) {
         let (k, dx) = (self.axis, self.dx);
         let nf = p.fluid;
         let (lo, hi) = p.x[..nf]
             .iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), x| (lo.min(x[k]), hi.max(x[k])));
-        if lo <= self.inlet || lo > self.inlet + dx {
-            return Err(SceneError::new(
-                "boundaries.inflow.position",
-                self.inlet,
-                format!(
-                    "must lie within Δx upstream of the fluid's first particles (at {lo:.6e}), so that the buffer continues the lattice"
-                ),
-            ));
-        }
-        if hi >= self.outlet || hi < self.outlet - dx {
-            return Err(SceneError::new(
-                "boundaries.outflow.position",
-                self.outlet,
-                format!("must lie within Δx downstream of the fluid's last particles (at {hi:.6e})"),
-            ));
-        }
         let mut inlet = 0;
         let mut link = InletLink { columns: self.columns, ..Default::default() };
         for a in 0..nf {
@@ -119,7 +102,7 @@ impl Openings {
             }
         }
         link.source = vec![u32::MAX; inlet];
-        Ok((inlet, link))
+        (inlet, link)
     }
 }
 

@@ -1,9 +1,9 @@
 //! Reordering of the fluid particles by cell, for memory locality of the neighbour loops.
 
 use crate::error::Cause;
+use crate::fields::{Fields, PermuteScratch, permute};
 use crate::neighbours::{CellSearch, Domain};
 use crate::stage::{Stage, StepContext};
-use crate::fields::{Fields, PermuteScratch, permute};
 use crate::state::State;
 
 /// Every `every` steps (from the first), permutes the fluid particles into cell order:

@@ -108,10 +108,9 @@ impl<const D: usize, O> Stage<D, O> for MirrorVelocity {
     }
 
     fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
-        let start = s.walls_start();
-        let (fluid, mirrors) = s.particles.u.split_at_mut(start);
-        for ((u, &src), &sign) in mirrors.iter_mut().zip(&s.mirrors.source).zip(&s.mirrors.sign) {
-            *u = fluid[src as usize] * sign;
+        let u = &mut s.particles.u;
+        for (b, source, sign) in s.links.velocity_copies() {
+            u[b] = u[source as usize] * sign;
         }
         Ok(())
     }

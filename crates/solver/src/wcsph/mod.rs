@@ -66,11 +66,18 @@ impl<const D: usize> Scheme<D> for Wcsph {
 
     fn build<K: Kernel>(scene: &Scene, kernel: Scaled<K, D>) -> Result<Composed<D, Self>, SceneError> {
         let SceneScheme::Wcsph(opts) = &scene.scheme else {
-            return Err(SceneError::new("scheme", "not wcsph", "must be `wcsph` for the weakly compressible scheme"));
+            return Err(SceneError::new(
+                "scheme",
+                "not wcsph",
+                "must be `wcsph` for the weakly compressible scheme",
+            ));
         };
-        let (state, _) = crate::setup::particle_state::<D>(scene, kernel.h, kernel.support)?;
-        let scheme =
-            Wcsph { sound_speed: opts.sound_speed, mu: scene.fluid.viscosity, sigma: scene.fluid.surface_tension };
+        let (state, _) = crate::setup::particle_state::<D>(scene, kernel.h, kernel.support);
+        let scheme = Wcsph {
+            sound_speed: opts.sound_speed,
+            mu: scene.fluid.viscosity,
+            sigma: scene.fluid.surface_tension,
+        };
         let stages = build_stages::<K, D>(scene, opts, kernel, state.domain);
         Ok(Composed { scheme, state, own: WcFields::default(), stages })
     }
@@ -153,12 +160,8 @@ fn build_stages<K: Kernel, const D: usize>(
     let tension = || -> Option<Box<dyn Stage<D, WcFields<D>>>> {
         // `young_laplace` (no force form) is rejected for WCSPH by the scene validation.
         Force::of(scene.fluid.surface_tension_model).filter(|_| sigma > 0.0).map(|force| {
-            Box::new(SurfaceTension::new(
-                sigma,
-                force,
-                scene.fluid.surface_tension_threshold,
-                kernel.h,
-            )) as Box<dyn Stage<D, WcFields<D>>>
+            Box::new(SurfaceTension::new(sigma, force, scene.fluid.surface_tension_threshold, kernel.h))
+                as Box<dyn Stage<D, WcFields<D>>>
         })
     };
     let mut prime = boundaries(false);
