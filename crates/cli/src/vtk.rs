@@ -1,4 +1,4 @@
-//! VTK XML unstructured-grid frames (`frames/frame_NNNNNN.vtu`) through the `vtkio` crate:
+//! VTK XML unstructured-grid frames (`frames/frame_NNNNNN.vtu`) through the `vtkio` crate (0.7):
 //! one vertex cell per particle with velocity, pressure and the free-surface flag, which
 //! ParaView opens directly.
 
@@ -40,7 +40,7 @@ pub fn write_frame_as(dir: &Path, stem: &str, frame: &Frame) -> anyhow::Result<P
         },
     };
     let vtk = Vtk {
-        version: Version::new((1, 0)),
+        version: Version::new_xml(1, 0),
         title: format!("meniscus step {} t = {:e} s", frame.step, frame.time),
         byte_order: ByteOrder::LittleEndian,
         data: DataSet::inline(piece),
