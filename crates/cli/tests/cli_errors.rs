@@ -163,6 +163,20 @@ fn diverged_run_writes_the_last_good_state() {
     assert!(err.contains(&format!("start of step {}", steps + 1)), "{err}");
     let vtu = std::fs::read_to_string(&last_good).unwrap();
     assert!(vtu.contains("pressure") && !vtu.contains("NaN"), "last_good.vtu holds finite data");
+    // It reads back, with finite positions, velocities and pressures for every particle.
+    let vtkio::model::DataSet::UnstructuredGrid { pieces, .. } = vtkio::Vtk::import(&last_good).unwrap().data
+    else {
+        panic!("not an unstructured grid")
+    };
+    let Some(vtkio::model::Piece::Inline(piece)) = pieces.first() else { panic!("no inline piece") };
+    let n = piece.num_points();
+    assert!(n > 0 && piece.points.cast_into::<f64>().unwrap().iter().all(|x| x.is_finite()));
+    for a in &piece.data.point {
+        let vtkio::model::Attribute::DataArray(d) = a else { panic!("field attribute") };
+        let values = d.data.cast_into::<f64>().unwrap();
+        assert_eq!(values.len(), n * d.elem.num_comp() as usize, "{}", d.name);
+        assert!(values.iter().all(|x| x.is_finite()), "{} finite", d.name);
+    }
     // Without frames it is written too.
     let out2 = dir.join("out2");
     let res = meniscus(&["run", s(&scene), "--out", s(&out2)]);
