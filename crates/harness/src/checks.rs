@@ -12,9 +12,9 @@
 //! another tier) is not applicable and is left out. A matching run that diverged, or a
 //! metric that is missing or not finite, fails the check (with a `note` saying why).
 
-use crate::case::Tier;
 use crate::fit::fit_power_law;
-use crate::results::RunResult;
+use crate::results::{CheckResult, RunResult};
+use crate::tier::Tier;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -106,22 +106,6 @@ pub struct CheckSpec {
     /// Tiers in which the check applies (all when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tiers: Option<Vec<Tier>>,
-}
-
-/// A check's outcome, as written to `results.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CheckResult {
-    /// Check name.
-    pub name: String,
-    /// Measured value (worst over the selected runs); `null` when it could not be measured.
-    pub value: Option<f64>,
-    /// The bound it is compared with (`decreasing`: 1, the largest allowed ratio).
-    pub threshold: Option<f64>,
-    /// Whether it passed.
-    pub pass: bool,
-    /// Why it failed when not because of the value (diverged run, missing metric).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub note: Option<String>,
 }
 
 impl CheckSpec {

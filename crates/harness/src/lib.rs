@@ -31,9 +31,11 @@ pub mod results;
 pub mod snapshots;
 pub mod stability;
 pub mod sweep;
+pub mod tier;
 pub mod validate;
 pub mod work_precision;
 
-pub use case::{Case, Tier};
+pub use case::Case;
 pub use error::{HarnessError, Result};
+pub use tier::Tier;
 pub use validate::{Outcome, ValidateOptions, validate};

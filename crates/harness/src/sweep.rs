@@ -1,10 +1,11 @@
 //! Expands a case into runs (tier spacings × presets) and executes one run in-process.
 
 use crate::cache::{CachedProbes, RunRecord, sha256_hex};
-use crate::case::{Case, Tier};
+use crate::case::Case;
 use crate::error::{HarnessError, Result};
 use crate::patch::merge_patch;
 use crate::results::slug;
+use crate::tier::Tier;
 
 /// One parameter point of a sweep, with its effective scene.
 #[derive(Debug, Clone)]

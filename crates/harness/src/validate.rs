@@ -3,7 +3,7 @@
 
 use crate::baseline::Comparison;
 use crate::cache::{self, RunRecord};
-use crate::case::{self, Case, Tier};
+use crate::case::{self, Case, CaseRecord};
 use crate::checks::evaluate_all;
 use crate::error::{HarnessError, Result};
 use crate::fit::fit_power_law;
@@ -12,8 +12,9 @@ use crate::metrics;
 use crate::progress::Progress;
 use crate::provenance::Provenance;
 use crate::report::{self, Baseline, RenderOptions};
-use crate::results::{CaseRecord, CaseResults, Convergence, RunResult, Summary};
+use crate::results::{CaseResults, Convergence, RunResult};
 use crate::sweep::{self, RunSpec};
+use crate::tier::Tier;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
@@ -62,19 +63,11 @@ impl Outcome {
     }
 }
 
-/// The names of the case files in `validation_dir` (their file stems), sorted.
-pub fn known_cases(validation_dir: &Path) -> Result<Vec<String>> {
-    Ok(case::discover(validation_dir, &[])?
-        .iter()
-        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
-        .collect())
-}
-
 /// Runs the validation described by `opts`; failed checks are results, not errors.
 pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     let paths = case::discover(&opts.validation_dir, &opts.cases)?;
     let cases: Vec<Case> = paths.iter().map(|p| Case::load(p)).collect::<Result<_>>()?;
-    let known = known_cases(&opts.validation_dir)?;
+    let known = case::known_cases(&opts.validation_dir)?;
     // Read the baseline before running anything: a wrong path fails at once, and a baseline
     // that is the output directory itself still holds the previous results.
     let baseline = opts.baseline.as_deref().map(|dir| Baseline::load(dir, Some(&known))).transpose()?;
@@ -115,7 +108,8 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
         ));
         outcome.results.push(results);
     }
-    let rendered = report::render(&opts.out, &RenderOptions { cases: Some(known), baseline })?;
+    let extras = crate::stability::extra_page(&opts.out).into_iter().collect();
+    let rendered = report::render(&opts.out, &RenderOptions { cases: Some(known), baseline, extras })?;
     outcome.comparison = rendered.comparison;
     Ok(outcome)
 }
@@ -269,11 +263,6 @@ pub fn convergence(case: &Case, runs: &[RunResult]) -> BTreeMap<String, Converge
     out
 }
 
-/// Rebuilds `summary.json` from the results present in `out` (see [`report::render_all`]).
-pub fn summary_of(results: &[CaseResults]) -> Summary {
-    Summary::new(results.iter().map(crate::results::CaseSummary::of).collect())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -412,7 +401,7 @@ mod tests {
         assert_eq!((second.executed, second.reused), (0, 1));
         let index = std::fs::read_to_string(opts.out.join("index.html")).unwrap();
         assert!(index.contains("tiny_drop/index.html") && !index.contains("stale_case"));
-        let summary: Summary = io::read_json(&opts.out.join("summary.json")).unwrap();
+        let summary: crate::results::Summary = io::read_json(&opts.out.join("summary.json")).unwrap();
         assert_eq!(summary.cases.len(), 1);
         assert_eq!(second.results[0].runs, first.results[0].runs);
         case.scene["time"]["end"] = serde_json::json!(0.0006);

@@ -2,7 +2,8 @@
 
 use super::FigureFile;
 use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
-use crate::results::{CaseRecord, CaseResults, RunResult, Summary};
+use crate::case::CaseRecord;
+use crate::results::{CaseResults, RunResult, Summary};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
 const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1200px;color:#222}\
@@ -417,18 +418,9 @@ pub struct ExtraPage {
     pub pass: bool,
 }
 
-/// `reports/index.html`: one row per case; with a comparison, a "vs baseline" column.
+/// `reports/index.html`: one row per case (with a comparison, a "vs baseline" column), then
+/// links to the `extras` pages.
 pub fn index_page(
-    results: &[CaseResults],
-    records: &[Option<&CaseRecord>],
-    summary: &Summary,
-    comparison: Option<&Comparison>,
-) -> String {
-    index_page_with(results, records, summary, comparison, &[])
-}
-
-/// [`index_page`] with links to the `extras` pages after the table of cases.
-pub fn index_page_with(
     results: &[CaseResults],
     records: &[Option<&CaseRecord>],
     summary: &Summary,

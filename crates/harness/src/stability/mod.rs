@@ -22,13 +22,14 @@ pub mod bisect;
 pub mod page;
 
 use crate::cache::{self, CachedProbes, RunRecord, sha256_hex};
-use crate::case::{Case, Tier};
-use crate::checks::CheckResult;
+use crate::case::Case;
 use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::patch::merge_patch;
 use crate::progress::Progress;
 use crate::provenance::Provenance;
+use crate::results::CheckResult;
+use crate::tier::Tier;
 use bisect::{Bracket, bisect};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
@@ -820,8 +821,9 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
     let page = page::render(&results);
     io::write_atomic(&dir.join("index.html"), page.as_bytes())?;
     // The index links the study.
-    let known = crate::validate::known_cases(&opts.validation_dir)?;
-    crate::report::render(&opts.out, &crate::report::RenderOptions { cases: Some(known), baseline: None })?;
+    let cases = Some(crate::case::known_cases(&opts.validation_dir)?);
+    let extras = vec![results.index_entry()];
+    crate::report::render(&opts.out, &crate::report::RenderOptions { cases, baseline: None, extras })?;
     Ok(results)
 }
 
@@ -934,6 +936,11 @@ pub fn checks(results: &StabilityResults, panics: usize) -> Vec<CheckResult> {
 /// `results.json` of a previous study in `out`, if any.
 pub fn load(out: &Path) -> Option<StabilityResults> {
     io::read_json(&out.join(NAME).join("results.json")).ok()
+}
+
+/// The report index's link to the study's page, when `out` holds a study.
+pub fn extra_page(out: &Path) -> Option<crate::report::ExtraPage> {
+    load(out).map(|s| s.index_entry())
 }
 
 #[cfg(test)]

@@ -12,8 +12,9 @@
 //! channel has no Dirichlet row).
 
 use super::Outcome;
-use crate::case::{Case, Tier};
+use crate::case::Case;
 use crate::error::{HarnessError, Result};
+use crate::tier::Tier;
 use meniscus::Scene;
 use meniscus::scene::schema::{PpeSolver, Preconditioner, Scheme, Shifting, ViscousIntegration};
 use serde::{Deserialize, Serialize};

@@ -9,8 +9,9 @@
 //! below Δx = 0.04 (see [`Design::for_tier`]). The two presets are also run with one
 //! thread at every spacing of the thread study, for the speed-up.
 
-use crate::case::{Case, Tier};
+use crate::case::Case;
 use crate::error::{HarnessError, Result};
+use crate::tier::Tier;
 use meniscus::Scene;
 use meniscus::scene::{Divergence, PpeSolver, Preconditioner, PressureGradient, Scheme, Shifting, TimeStep};
 use serde::{Deserialize, Serialize};

@@ -23,11 +23,12 @@ pub mod plots;
 pub mod record;
 pub mod targets;
 
-use crate::case::{Case, Tier};
+use crate::case::Case;
 use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::metrics;
 use crate::provenance::Provenance;
+use crate::tier::Tier;
 use channel::ChannelStudy;
 use design::{Design, Planned, Ppe, Variant};
 use record::{Machine, RunRow, Study};
