@@ -357,12 +357,25 @@ pub fn known_cases(validation_dir: &Path) -> Result<Vec<String>> {
 }
 
 #[cfg(test)]
+pub(crate) mod testing {
+    //! The committed case files, for tests.
+
+    use super::Case;
+    use std::path::Path;
+
+    /// `validation/<name>.json` of this repository.
+    pub(crate) fn committed(name: &str) -> Case {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../validation/{name}.json"));
+        Case::load(&path).expect("the committed case file parses")
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
 
     fn repo_case() -> Case {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json");
-        Case::load(&path).expect("the committed case file parses")
+        testing::committed("elliptical_drop")
     }
 
     #[test]

@@ -28,6 +28,7 @@ pub mod progress;
 pub mod provenance;
 pub mod report;
 pub mod results;
+pub mod runner;
 pub mod snapshots;
 pub mod stability;
 pub mod sweep;

@@ -240,7 +240,6 @@ pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::case::Case;
     use crate::io::testing::Scratch;
     use crate::provenance::Provenance;
 
@@ -278,9 +277,7 @@ mod tests {
         let out = dir.path();
         let results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
         io::write_json(&out.join("elliptical_drop/results.json"), &results).unwrap();
-        let case =
-            Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
-                .unwrap();
+        let case = crate::case::testing::committed("elliptical_drop");
         let record = CaseRecord {
             case,
             provenance: Provenance {
@@ -347,9 +344,7 @@ mod tests {
     #[test]
     fn snapshot_figures_pair_the_presets_per_time() {
         let dir = Scratch::new("report-snapshots");
-        let case =
-            Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/rotating_square.json"))
-                .unwrap();
+        let case = crate::case::testing::committed("rotating_square");
         let mut results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
         results.case = "rotating_square".into();
         results.runs.truncate(2);

@@ -467,6 +467,7 @@ impl Runner<'_> {
                             summary: report.summary,
                             probes: CachedProbes::from(report.probes),
                             snapshots: Vec::new(),
+                            cpu_s: None,
                         };
                         cache::store(&path, &record)?;
                         Some(record)

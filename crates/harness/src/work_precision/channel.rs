@@ -332,11 +332,9 @@ pub fn row(case: &Case, planned: &ChannelPlanned, scene: &Scene, outcome: Outcom
 mod tests {
     use super::*;
     use std::collections::HashSet;
-    use std::path::Path;
 
     fn case() -> Case {
-        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/poiseuille_periodic.json"))
-            .unwrap()
+        crate::case::testing::committed("poiseuille_periodic")
     }
 
     #[test]

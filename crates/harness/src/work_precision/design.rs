@@ -388,11 +388,9 @@ pub fn scene(case: &Case, variant: &Variant, dx: f64) -> Result<Scene> {
 mod tests {
     use super::*;
     use std::collections::HashSet;
-    use std::path::Path;
 
     fn case() -> Case {
-        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
-            .unwrap()
+        crate::case::testing::committed("elliptical_drop")
     }
 
     #[test]
