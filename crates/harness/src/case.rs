@@ -310,6 +310,14 @@ impl Case {
         }
         for c in &self.checks {
             c.validate().map_err(|m| err(format!("check `{}`: {m}", c.display_name())))?;
+            for (field, v) in [("study", &c.select.study), ("case", &c.select.case)] {
+                if let Some(v) = v {
+                    return Err(err(format!(
+                        "check `{}`: `select.{field}` = {v:?}: selects a study's rows; a case's runs have no {field}",
+                        c.display_name()
+                    )));
+                }
+            }
         }
         Ok(())
     }
@@ -399,5 +407,9 @@ mod tests {
         let mut v = serde_json::to_value(repo_case()).unwrap();
         v["bogus"] = 1.into();
         assert!(Case::from_json(&v.to_string(), Path::new("x.json")).is_err());
+        let mut v = serde_json::to_value(repo_case()).unwrap();
+        v["checks"][0]["select"]["study"] = "dt_max".into();
+        let e = Case::from_json(&v.to_string(), Path::new("x.json")).unwrap_err();
+        assert!(e.to_string().contains("`select.study` = \"dt_max\""), "{e}");
     }
 }
