@@ -24,7 +24,7 @@ use crate::sweep::RunSpec;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 
 /// One run for the runner.
 #[derive(Debug, Clone)]
@@ -141,8 +141,9 @@ impl Runner {
     /// Runs (or reuses) `jobs`, their records under `<dir>/runs/`, with a bar counting them
     /// when `bar` names the batch. `finish` turns job `i`'s outcome into the study's item
     /// and the line printed for it (on the worker, as soon as the job ends). Returns the
-    /// items in job order; an invalid scene, a failed write or an error of `finish` is an
-    /// error (the first in job order, after every job ended).
+    /// items in job order. An invalid scene, a failed write or an error of `finish` is an
+    /// error: no job starts after it, and the first in job order is returned once the
+    /// running ones ended.
     pub fn run<T: Send>(
         &self,
         dir: &Path,
@@ -154,11 +155,12 @@ impl Runner {
         let batch = bar.map(|name| self.progress.case_bar(name, jobs.len()));
         let slots: Vec<Mutex<Option<Result<T>>>> = jobs.iter().map(|_| Mutex::new(None)).collect();
         let next = AtomicUsize::new(0);
+        let failed = AtomicBool::new(false);
         let workers = self.jobs.min(jobs.len()).max(1);
         let share = (workers > 1).then(|| (rayon::current_num_threads() / workers).max(1));
         let worker = || {
             let mut pools = BTreeMap::new();
-            loop {
+            while !failed.load(Ordering::Relaxed) {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(job) = jobs.get(i) else { break };
                 let threads = job.threads.or(share);
@@ -175,6 +177,9 @@ impl Runner {
                 });
                 if let Some(b) = &batch {
                     b.inc(1);
+                }
+                if item.is_err() {
+                    failed.store(true, Ordering::Relaxed);
                 }
                 *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(item);
             }
@@ -196,10 +201,13 @@ impl Runner {
                 t.reused - before.reused
             ));
         }
-        slots
+        // Jobs are taken in order, so every job before the first failed one ran.
+        let items = slots
             .into_iter()
-            .map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()).expect("every job ran"))
-            .collect()
+            .map_while(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
+            .collect::<Result<Vec<T>>>()?;
+        assert_eq!(items.len(), jobs.len(), "without an error every job ran");
+        Ok(items)
     }
 
     /// Reuses or runs one job (on `pool` when given).
@@ -314,5 +322,12 @@ mod tests {
         let out = runner.run(dir.path(), None, &jobs, finish).unwrap();
         assert_eq!(out[0], (0, "ok".to_string(), true), "reused");
         assert_eq!(runner.tally(), Tally { executed: 1, reused: 1, panicked: 1 });
+        // An error (here the study's) starts no further job.
+        let runner = Runner::new(Progress::silent(), true, 1);
+        let failing = |i: usize, _: Ran| {
+            if i == 0 { Err(HarnessError::case("tiny", "bad")) } else { Ok(((), String::new())) }
+        };
+        assert!(runner.run(dir.path(), None, &jobs, failing).is_err());
+        assert_eq!(runner.tally().executed, 1);
     }
 }
