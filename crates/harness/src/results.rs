@@ -94,14 +94,19 @@ pub struct CaseResults {
 impl CaseResults {
     /// Number of passed and failed checks.
     pub fn counts(&self) -> (usize, usize) {
-        let passed = self.checks.iter().filter(|c| c.pass).count();
-        (passed, self.checks.len() - passed)
+        check_counts(&self.checks)
     }
 
     /// Whether every check passed.
     pub fn pass(&self) -> bool {
-        self.checks.iter().all(|c| c.pass)
+        check_counts(&self.checks).1 == 0
     }
+}
+
+/// Passed and failed checks among `checks`.
+pub fn check_counts(checks: &[CheckResult]) -> (usize, usize) {
+    let passed = checks.iter().filter(|c| c.pass).count();
+    (passed, checks.len() - passed)
 }
 
 /// One case in `reports/summary.json`.

@@ -133,14 +133,11 @@ pub fn expand(case: &Case, tier: Tier) -> Result<Vec<RunSpec>> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn case() -> Case {
-        crate::case::testing::committed("elliptical_drop")
-    }
+    use crate::case::testing::committed;
 
     #[test]
     fn expands_tier_into_slugged_runs() {
-        let runs = expand(&case(), Tier::Quick).unwrap();
+        let runs = expand(&committed("elliptical_drop"), Tier::Quick).unwrap();
         let slugs: Vec<&str> = runs.iter().map(|r| r.slug.as_str()).collect();
         assert_eq!(
             slugs,
@@ -168,7 +165,7 @@ mod tests {
         assert_eq!(runs[0].hash.len(), 64);
         assert_ne!(runs[0].hash, runs[1].hash);
         assert_ne!(runs[0].hash, runs[4].hash);
-        let full = expand(&case(), Tier::Full).unwrap();
+        let full = expand(&committed("elliptical_drop"), Tier::Full).unwrap();
         assert_eq!(full.len(), 16);
         // Δt scales with dx below the template's 0.02 (CFL number kept), not above it.
         let dt = |r: &RunSpec| r.scene_json["time"]["step"]["fixed"].as_f64().unwrap();
@@ -179,7 +176,7 @@ mod tests {
 
     #[test]
     fn hash_is_stable_and_follows_the_scene() {
-        let c = case();
+        let c = committed("elliptical_drop");
         let a = spec(&c, "paper", 0.04).unwrap();
         assert_eq!(a.hash, spec(&c, "paper", 0.04).unwrap().hash);
         let mut changed = c.clone();
@@ -189,7 +186,7 @@ mod tests {
 
     #[test]
     fn bad_preset_patch_names_the_run() {
-        let mut c = case();
+        let mut c = committed("elliptical_drop");
         c.sweep.presets[1].patch = serde_json::json!({"fluid": {"density": -1.0}});
         let e = expand(&c, Tier::Quick).unwrap_err().to_string();
         assert!(e.contains("isph-tuned_dx0.04") && e.contains("density"), "{e}");

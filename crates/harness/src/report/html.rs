@@ -3,7 +3,7 @@
 use super::FigureFile;
 use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
 use crate::case::CaseRecord;
-use crate::results::{CaseResults, RunResult, Summary};
+use crate::results::{CaseResults, CheckResult, RunResult, Summary};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
 const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1200px;color:#222}\
@@ -183,6 +183,24 @@ pub(crate) fn pass_cell(pass: bool) -> Markup {
     html! { td class=(if pass { "pass" } else { "fail" }) { (if pass { "PASS" } else { "FAIL" }) } }
 }
 
+/// The table of checks: name, value and threshold (written by `number`), verdict, note.
+pub(crate) fn checks_table(checks: &[CheckResult], number: fn(f64) -> String) -> Markup {
+    html! {
+        table {
+            tr { th class="l" { "check" } th { "value" } th { "threshold" } th { "result" } th class="l" { "note" } }
+            @for c in checks {
+                tr {
+                    td class="l" { (c.name) }
+                    td { (c.value.map_or("—".to_string(), number)) }
+                    td { (c.threshold.map_or("—".to_string(), number)) }
+                    (pass_cell(c.pass))
+                    td class="l" { (c.note.as_deref().unwrap_or("")) }
+                }
+            }
+        }
+    }
+}
+
 pub(crate) fn page(title: &str, body: Markup) -> String {
     html! {
         (DOCTYPE)
@@ -255,18 +273,7 @@ pub fn case_page(
             }
         }
         h2 { "Checks" }
-        table {
-            tr { th class="l" { "check" } th { "value" } th { "threshold" } th { "result" } th class="l" { "note" } }
-            @for c in &results.checks {
-                tr {
-                    td class="l" { (c.name) }
-                    td { (c.value.map_or("—".to_string(), |v| format!("{v:.4e}"))) }
-                    td { (c.threshold.map_or("—".to_string(), |v| format!("{v:.4e}"))) }
-                    (pass_cell(c.pass))
-                    td class="l" { (c.note.as_deref().unwrap_or("")) }
-                }
-            }
-        }
+        (checks_table(&results.checks, |v| format!("{v:.4e}")))
         @if let Some(cmp) = comparison {
             @if let Some(case) = cmp.case(&results.case) { (baseline_section(cmp, case)) }
         }

@@ -35,7 +35,7 @@ use crate::patch::merge_patch;
 use crate::progress::Progress;
 use crate::provenance::Provenance;
 use crate::report::html::format_dx;
-use crate::results::{CheckResult, RunResult};
+use crate::results::{CheckResult, RunResult, check_counts};
 use crate::runner::{Job, Ran, Runner};
 use crate::sweep::{RunSpec, effective_scene};
 use crate::tier::Tier;
@@ -186,13 +186,12 @@ pub struct StabilityResults {
 impl StabilityResults {
     /// Passed and failed checks.
     pub fn counts(&self) -> (usize, usize) {
-        let passed = self.checks.iter().filter(|c| c.pass).count();
-        (passed, self.checks.len() - passed)
+        check_counts(&self.checks)
     }
 
     /// Whether every check passed.
     pub fn pass(&self) -> bool {
-        self.checks.iter().all(|c| c.pass)
+        check_counts(&self.checks).1 == 0
     }
 }
 
@@ -418,7 +417,29 @@ struct Search<'a> {
     particles: usize,
 }
 
-impl Search<'_> {
+impl<'a> Search<'a> {
+    /// The bisection of `study` (of the quantity `symbol`) over `range` in `iterations`
+    /// steps on `base`, described by `config`; `job` tries a value.
+    fn new(
+        base: &'a Base,
+        (study, symbol): (&'static str, &'static str),
+        config: String,
+        (range, iterations): ([f64; 2], usize),
+        job: impl Fn(f64) -> Result<Job> + 'a,
+    ) -> Self {
+        let bisection = Bisection::new(range[0], range[1], iterations);
+        Search {
+            base,
+            study,
+            symbol,
+            config,
+            bisection,
+            job: Box::new(job),
+            trials: Vec::new(),
+            particles: 0,
+        }
+    }
+
     /// The bisection's row.
     fn row(self, set: &OptionSet) -> Row {
         let bracket = self.bisection.bracket().expect("the bisection is done");
@@ -620,23 +641,14 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
                 s.dt_range[0],
                 s.dt_range[1]
             );
-            searches.push(Search {
-                base,
-                study: "dt_max",
-                symbol: "k",
-                config,
-                bisection: Bisection::new(s.dt_range[0], s.dt_range[1], s.dt_iterations),
-                job: Box::new(move |k| {
-                    let slug = format!("{}-{}-dt_k{}", base.short(), set.name, slug_value(k));
-                    base.job(set, slug, |v| {
-                        base.set_end(v);
-                        v["time"]["step"] =
-                            json!({"adaptive": {"cfl": ALPHA * k, "viscous": ALPHA * k, "max": template_max * k}});
-                    })
-                }),
-                trials: Vec::new(),
-                particles: 0,
-            });
+            searches.push(Search::new(base, ("dt_max", "k"), config, (s.dt_range, s.dt_iterations), move |k| {
+                let slug = format!("{}-{}-dt_k{}", base.short(), set.name, slug_value(k));
+                base.job(set, slug, |v| {
+                    base.set_end(v);
+                    v["time"]["step"] =
+                        json!({"adaptive": {"cfl": ALPHA * k, "viscous": ALPHA * k, "max": template_max * k}});
+                })
+            }));
         }
         if set.scheme == "isph" {
             let config = format!(
@@ -648,22 +660,19 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
                 s.re_range[1]
             );
             let base = &channel;
-            searches.push(Search {
+            searches.push(Search::new(
                 base,
-                study: "re_max",
-                symbol: "Re",
+                ("re_max", "Re"),
                 config,
-                bisection: Bisection::new(s.re_range[0], s.re_range[1], s.re_iterations),
-                job: Box::new(move |re| {
+                (s.re_range, s.re_iterations),
+                move |re| {
                     let force = 12.0 * nu * nu * re / width.powi(3);
                     base.job(set, format!("channel-{}-re{}", set.name, slug_value(re)), |v| {
                         base.set_end(v);
                         v["body_force"] = json!([force, 0.0]);
                     })
-                }),
-                trials: Vec::new(),
-                particles: 0,
-            });
+                },
+            ));
         }
         bisect_together(&runner, &dir, &mut searches)?;
         results.runs.extend(searches.into_iter().map(|search| search.row(set)));

@@ -1,7 +1,7 @@
 //! `reports/stability/index.html`: the envelope's rows, grouped by study, self-contained.
 
 use super::{Config, Row, StabilityResults, pct};
-use crate::report::html::{ExtraPage, format_dx, page as html_page, pass_cell};
+use crate::report::html::{ExtraPage, checks_table, format_dx, page as html_page};
 use maud::{Markup, html};
 
 impl StabilityResults {
@@ -120,18 +120,7 @@ pub fn render(res: &StabilityResults, config: &Config) -> String {
         }
         p class=(if failed == 0 { "pass" } else { "fail" }) { (passed) " / " (passed + failed) " checks passed" }
         h2 { "Checks" }
-        table {
-            tr { th class="l" { "check" } th { "value" } th { "threshold" } th { "result" } th class="l" { "note" } }
-            @for c in &res.checks {
-                tr {
-                    td class="l" { (c.name) }
-                    td { (c.value.map_or("—".to_string(), |v| format!("{v:.4}"))) }
-                    td { (c.threshold.map_or("—".to_string(), |v| format!("{v:.4}"))) }
-                    (pass_cell(c.pass))
-                    td class="l" { (c.note.as_deref().unwrap_or("")) }
-                }
-            }
-        }
+        (checks_table(&res.checks, |v| format!("{v:.4}")))
         h2 { "Option sets" }
         ul {
             @for set in config.option_sets.iter().filter(|o| s.option_sets.contains(&o.name)) {

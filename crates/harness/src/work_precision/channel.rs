@@ -317,15 +317,12 @@ pub fn row(case: &Case, planned: &ChannelPlanned, ran: &Ran) -> Result<ChannelRo
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::case::testing::committed;
     use std::collections::HashSet;
-
-    fn case() -> Case {
-        crate::case::testing::committed("poiseuille_periodic")
-    }
 
     #[test]
     fn presets_match_the_case_file() {
-        let c = case();
+        let c = committed("poiseuille_periodic");
         for v in [ChannelVariant::EXPLICIT, ChannelVariant::IMPLICIT] {
             let name = v.preset().unwrap();
             for dx in [D36, 0.0025] {

@@ -387,15 +387,12 @@ pub fn scene(case: &Case, variant: &Variant, dx: f64) -> Result<Scene> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::case::testing::committed;
     use std::collections::HashSet;
-
-    fn case() -> Case {
-        crate::case::testing::committed("elliptical_drop")
-    }
 
     #[test]
     fn presets_match_the_case_file() {
-        let c = case();
+        let c = committed("elliptical_drop");
         for (name, v) in [("paper", Variant::PAPER), ("tuned", Variant::TUNED)] {
             for dx in [0.04, 0.01] {
                 let spec = crate::sweep::spec(&c, name, dx).unwrap();
@@ -408,7 +405,7 @@ mod tests {
 
     #[test]
     fn factors_reach_the_scene() {
-        let c = case();
+        let c = committed("elliptical_drop");
         let v = Variant {
             ppe: Ppe::Cg3,
             gradient: Gradient::Difference,
