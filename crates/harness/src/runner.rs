@@ -163,18 +163,28 @@ impl Runner {
             while !failed.load(Ordering::Relaxed) {
                 let i = next.fetch_add(1, Ordering::Relaxed);
                 let Some(job) = jobs.get(i) else { break };
-                let threads = job.threads.or(share);
-                let pool = threads.and_then(|k| {
-                    pools
-                        .entry(k)
-                        .or_insert_with(|| rayon::ThreadPoolBuilder::new().num_threads(k).build())
-                        .as_ref()
-                        .ok()
-                });
-                let item = self.one(dir, job, pool).and_then(|ran| finish(i, ran)).map(|(item, line)| {
-                    self.progress.println(&line);
-                    item
-                });
+                // A share that cannot be had runs on the global pool; asked-for threads must be.
+                let pool = match job.threads.or(share).map(|k| {
+                    (
+                        k,
+                        pools
+                            .entry(k)
+                            .or_insert_with(|| rayon::ThreadPoolBuilder::new().num_threads(k).build()),
+                    )
+                }) {
+                    Some((_, Ok(pool))) => Ok(Some(&*pool)),
+                    Some((k, Err(e))) if job.threads.is_some() => Err(HarnessError::case(
+                        &job.spec.case,
+                        format!("run {}: no rayon pool of {k} threads: {e}", job.spec.slug),
+                    )),
+                    _ => Ok(None),
+                };
+                let item = pool.and_then(|pool| self.one(dir, job, pool)).and_then(|ran| finish(i, ran)).map(
+                    |(item, line)| {
+                        self.progress.println(&line);
+                        item
+                    },
+                );
                 if let Some(b) = &batch {
                     b.inc(1);
                 }
