@@ -1,4 +1,4 @@
-//! `cargo xtask bench [--quick|--full] [--out DIR] [--threads N]`: the work-precision
+//! `cargo xtask bench [--quick|--full] [--out DIR] [--threads N] [--resume]`: the work-precision
 //! study of the elliptical drop and the periodic Poiseuille channel into
 //! `reports/work_precision/`, in a release build (a dev-build invocation re-runs itself through
 //! `cargo run --release` unless `--dev-build`).
@@ -26,6 +26,10 @@ pub struct Args {
     /// No line per run.
     #[arg(long)]
     no_progress: bool,
+    /// Reuse the runs an interrupted study of the same build left in <out>/runs/ (marked
+    /// cached in results.json and on the page; their times are those measured then).
+    #[arg(long)]
+    resume: bool,
     /// Run in the build `cargo xtask` was started in (dev: opt-level 3 with debug
     /// assertions, about 8 % slower) instead of re-running in a release build.
     #[arg(long)]
@@ -55,6 +59,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         workspace: root.clone(),
         threads: args.threads.max(1),
         progress: !args.no_progress,
+        resume: args.resume,
     };
     let study = work_precision::run(&opts).context("the work-precision study could not run")?;
     let diverged = study.runs.iter().filter(|r| !r.ok()).count();

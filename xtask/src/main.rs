@@ -1,6 +1,7 @@
-//! Project tasks: `cargo xtask validate | bench | report` (DESIGN.md "Command lines").
+//! Project tasks: `cargo xtask validate | bench | report | deps` (DESIGN.md "Command lines").
 //!
-//! Thin by design: parsing and dispatch only; the logic lives in `meniscus-harness`.
+//! Thin by design: parsing and dispatch only; the logic lives in `meniscus-harness` (and,
+//! for `deps`, in this package's library, which tests call).
 
 mod bench;
 mod report;
@@ -29,6 +30,9 @@ enum Command {
     Bench(bench::Args),
     /// Re-render the HTML report and summary.json from the existing results files (no runs).
     Report(report::Args),
+    /// Print a crate's module graph (who uses whom, in layers); exit code 1 on an import
+    /// cycle.
+    Deps(xtask::deps::Args),
 }
 
 fn main() -> ExitCode {
@@ -37,6 +41,7 @@ fn main() -> ExitCode {
         Command::Validate(args) => validate::run(args),
         Command::Bench(args) => bench::run(args),
         Command::Report(args) => report::run(args),
+        Command::Deps(args) => xtask::deps::run(args, &workspace_root()),
     };
     match result {
         Ok(code) => code,

@@ -22,9 +22,11 @@ pub struct Args {
 pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let root = crate::workspace_root();
     let out = args.out.unwrap_or_else(|| root.join("reports"));
-    let cases = meniscus_harness::validate::known_cases(&root.join("validation"))?;
+    let cases = meniscus_harness::case::known_cases(&root.join("validation"))?;
     let baseline = args.baseline.as_deref().map(|dir| Baseline::load(dir, Some(&cases))).transpose()?;
-    let rendered = meniscus_harness::report::render(&out, &RenderOptions { cases: Some(cases), baseline })?;
+    let extras = meniscus_harness::stability::extra_page(&out).into_iter().collect();
+    let rendered =
+        meniscus_harness::report::render(&out, &RenderOptions { cases: Some(cases), baseline, extras })?;
     if rendered.results.is_empty() {
         anyhow::bail!("no <case>/results.json under {}: run `cargo xtask validate` first", out.display());
     }

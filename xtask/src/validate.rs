@@ -17,7 +17,8 @@ pub struct Args {
     #[arg(long)]
     full: bool,
     /// Run only this case (repeatable); all of validation/*.json by default. `stability`
-    /// runs the stability envelope (reports/stability/), which the full tier also runs.
+    /// runs the stability envelope (reports/stability/, its data in
+    /// validation/studies/stability.json), which the full tier also runs.
     #[arg(long = "case", value_name = "NAME")]
     cases: Vec<String>,
     /// Output directory [default: <workspace>/reports].
@@ -82,8 +83,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             validation_dir: opts.validation_dir.clone(),
             workspace: root.clone(),
             tier,
-            settings: stability::Settings::standard(),
+            config: stability::Config::load(&opts.validation_dir)?,
             force: opts.force,
+            jobs: opts.jobs,
             progress: opts.progress,
         })
         .context("the stability envelope could not run")?;

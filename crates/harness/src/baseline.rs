@@ -18,7 +18,8 @@
 //!   passed and now fails is *newly failing*.
 
 use crate::error::{HarnessError, Result};
-use crate::results::{CaseResults, RunResult, slug};
+use crate::io;
+use crate::results::{CaseResults, RunResult, case_dirs, slug};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -480,7 +481,10 @@ pub fn compare(baseline_dir: &Path, new: &[CaseResults], old: &[CaseResults], ba
 /// given). A directory holding no results file is an error, so a mistyped path does not
 /// silently compare against nothing.
 pub fn load(dir: &Path, cases: Option<&[String]>) -> Result<Vec<CaseResults>> {
-    let found = crate::report::collect_cases(dir, cases)?;
+    let found: Vec<CaseResults> = case_dirs(dir, cases)
+        .iter()
+        .map(|d| io::read_json(&d.join("results.json")))
+        .collect::<Result<_>>()?;
     if found.is_empty() {
         return Err(HarnessError::Io {
             path: dir.to_path_buf(),
@@ -490,7 +494,7 @@ pub fn load(dir: &Path, cases: Option<&[String]>) -> Result<Vec<CaseResults>> {
             ),
         });
     }
-    Ok(found.into_iter().map(|(r, _)| r).collect())
+    Ok(found)
 }
 
 #[cfg(test)]

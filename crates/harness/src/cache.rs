@@ -34,6 +34,21 @@ pub struct RunRecord {
     /// The particles at the scene's `output.snapshot_times` (2D runs; absent when none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub snapshots: Vec<crate::snapshots::Snapshot>,
+    /// CPU time of the process (all threads) over the run \[s\], when the runner ran one
+    /// run at a time on Linux (the work-precision study reports it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cpu_s: Option<f64>,
+}
+
+impl RunRecord {
+    /// The run's status as DESIGN.md writes it: `ok`, or `diverged: <cause at step/time>`.
+    pub fn status(&self) -> String {
+        if self.summary.status == meniscus::Status::Ok && self.summary.error.is_none() {
+            "ok".to_string()
+        } else {
+            format!("diverged: {}", self.summary.error.as_deref().unwrap_or("unknown cause"))
+        }
+    }
 }
 
 /// `probes.json` content that survives NaN samples (written as `null`, read back as NaN).
@@ -135,6 +150,7 @@ pub(crate) mod tests {
                     .into(),
             },
             snapshots: Vec::new(),
+            cpu_s: None,
         }
     }
 

@@ -18,39 +18,11 @@
 use crate::checks::CheckSpec;
 use crate::error::{HarnessError, Result};
 use crate::io;
+use crate::provenance::Provenance;
+use crate::tier::Tier;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-
-/// A sweep tier (CASES.md): `quick` is CI, `default` the papers' spacings, `full` the
-/// extended sweep.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum Tier {
-    /// CI tier (`--quick`).
-    Quick,
-    /// The papers' spacings (no flag).
-    Default,
-    /// Finer spacings and long runs (`--full`).
-    Full,
-}
-
-impl Tier {
-    /// The tier's name as written in files.
-    pub fn name(self) -> &'static str {
-        match self {
-            Tier::Quick => "quick",
-            Tier::Default => "default",
-            Tier::Full => "full",
-        }
-    }
-}
-
-impl std::fmt::Display for Tier {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(self.name())
-    }
-}
 
 /// A validation case, as read from `validation/<case>.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -338,9 +310,29 @@ impl Case {
         }
         for c in &self.checks {
             c.validate().map_err(|m| err(format!("check `{}`: {m}", c.display_name())))?;
+            for (field, v) in [("study", &c.select.study), ("case", &c.select.case)] {
+                if let Some(v) = v {
+                    return Err(err(format!(
+                        "check `{}`: `select.{field}` = {v:?}: selects a study's rows; a case's runs have no {field}",
+                        c.display_name()
+                    )));
+                }
+            }
         }
         Ok(())
     }
+}
+
+/// Side file `reports/<case>/provenance.json`: the case file as run and where/when/what
+/// produced the results (kept out of results.json to keep that contract exact).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct CaseRecord {
+    /// The case file as it was when the results were produced.
+    pub case: Case,
+    /// Machine, commit, date.
+    pub provenance: Provenance,
+    /// SHA-256 of each run's effective scene, by slug.
+    pub scene_hashes: BTreeMap<String, String>,
 }
 
 /// Finds case files: `validation/*.json` (sorted by name), or only the `names` given.
@@ -364,13 +356,34 @@ pub fn discover(validation_dir: &Path, names: &[String]) -> Result<Vec<PathBuf>>
     Ok(paths)
 }
 
+/// The names of the case files in `validation_dir` (their file stems), sorted.
+pub fn known_cases(validation_dir: &Path) -> Result<Vec<String>> {
+    Ok(discover(validation_dir, &[])?
+        .iter()
+        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .collect())
+}
+
+#[cfg(test)]
+pub(crate) mod testing {
+    //! The committed case files, for tests.
+
+    use super::Case;
+    use std::path::Path;
+
+    /// `validation/<name>.json` of this repository.
+    pub(crate) fn committed(name: &str) -> Case {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("../../validation/{name}.json"));
+        Case::load(&path).expect("the committed case file parses")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
 
     fn repo_case() -> Case {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json");
-        Case::load(&path).expect("the committed case file parses")
+        testing::committed("elliptical_drop")
     }
 
     #[test]
@@ -394,5 +407,9 @@ mod tests {
         let mut v = serde_json::to_value(repo_case()).unwrap();
         v["bogus"] = 1.into();
         assert!(Case::from_json(&v.to_string(), Path::new("x.json")).is_err());
+        let mut v = serde_json::to_value(repo_case()).unwrap();
+        v["checks"][0]["select"]["study"] = "dt_max".into();
+        let e = Case::from_json(&v.to_string(), Path::new("x.json")).unwrap_err();
+        assert!(e.to_string().contains("`select.study` = \"dt_max\""), "{e}");
     }
 }

@@ -10,11 +10,16 @@
 //! `kind` defaults from the bound given (`max`, `min` or `value`). A check applies to the
 //! runs its `select` matches in the tier being run; a check matching no run (a spacing of
 //! another tier) is not applicable and is left out. A matching run that diverged, or a
-//! metric that is missing or not finite, fails the check (with a `note` saying why).
+//! metric that is missing or not finite, fails the check (with a `note` saying why; the
+//! check's `missing` replaces the note of a missing metric).
+//!
+//! The stability envelope's rows are checked by the same specs ([`Checked`]): their
+//! selectors also name the `study` and `case` of a row, and a row's status does not fail
+//! a check.
 
-use crate::case::Tier;
 use crate::fit::fit_power_law;
-use crate::results::RunResult;
+use crate::results::{CheckResult, RunResult};
+use crate::tier::Tier;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -35,6 +40,34 @@ pub enum CheckKind {
     Order,
 }
 
+/// A row a check can select and read: a case's run, or a row of a study (the stability
+/// envelope), which names its study and case.
+pub trait Checked {
+    /// The run's fields and metrics.
+    fn run(&self) -> &RunResult;
+    /// The study of the row (`dt_max`, ...); none for a case's run.
+    fn study(&self) -> Option<&str> {
+        None
+    }
+    /// The case the row ran; none for a case's run (the file is the case).
+    fn case(&self) -> Option<&str> {
+        None
+    }
+    /// Why the row's values do not count (`<slug> <status>` of a diverged run): every check
+    /// selecting it fails.
+    fn failure(&self) -> Option<String>;
+}
+
+impl Checked for RunResult {
+    fn run(&self) -> &RunResult {
+        self
+    }
+
+    fn failure(&self) -> Option<String> {
+        (!self.ok()).then(|| format!("{} {}", self.slug(), self.status))
+    }
+}
+
 /// Which runs a check applies to (all fields optional; absent = any).
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -48,14 +81,23 @@ pub struct Selector {
     /// Scheme name.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub scheme: Option<String>,
+    /// Study of a study's row (`dt_max`, ...): a case's runs have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub study: Option<String>,
+    /// Case of a study's row: a case's runs have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub case: Option<String>,
 }
 
 impl Selector {
-    /// Whether `run` matches.
-    pub fn matches(&self, run: &RunResult) -> bool {
+    /// Whether `row` matches.
+    pub fn matches(&self, row: &impl Checked) -> bool {
+        let run = row.run();
         self.dx.is_none_or(|d| (run.dx - d).abs() <= 1e-9 * d.abs())
             && self.preset.as_ref().is_none_or(|p| *p == run.preset)
             && self.scheme.as_ref().is_none_or(|s| *s == run.scheme)
+            && self.study.as_deref().is_none_or(|s| row.study() == Some(s))
+            && self.case.as_deref().is_none_or(|c| row.case() == Some(c))
     }
 
     fn describe(&self) -> String {
@@ -66,7 +108,7 @@ impl Selector {
         if let Some(p) = &self.preset {
             parts.push(p.clone());
         }
-        if let Some(s) = &self.scheme {
+        for s in [&self.scheme, &self.study, &self.case].into_iter().flatten() {
             parts.push(s.clone());
         }
         if parts.is_empty() { String::new() } else { format!(" ({})", parts.join(", ")) }
@@ -106,22 +148,10 @@ pub struct CheckSpec {
     /// Tiers in which the check applies (all when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tiers: Option<Vec<Tier>>,
-}
-
-/// A check's outcome, as written to `results.json`.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CheckResult {
-    /// Check name.
-    pub name: String,
-    /// Measured value (worst over the selected runs); `null` when it could not be measured.
-    pub value: Option<f64>,
-    /// The bound it is compared with (`decreasing`: 1, the largest allowed ratio).
-    pub threshold: Option<f64>,
-    /// Whether it passed.
-    pub pass: bool,
-    /// Why it failed when not because of the value (diverged run, missing metric).
+    /// The note when the metric is missing or not finite (absent: one naming the metric
+    /// and the runs).
     #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub note: Option<String>,
+    pub missing: Option<String>,
 }
 
 impl CheckSpec {
@@ -155,6 +185,21 @@ impl CheckSpec {
         }
     }
 
+    /// The bound the value is compared with (`decreasing`: 1, the largest allowed ratio).
+    pub fn threshold(&self) -> Option<f64> {
+        match self.kind()? {
+            CheckKind::Max => self.max,
+            CheckKind::Min | CheckKind::Order => self.min,
+            CheckKind::Equals => self.value,
+            CheckKind::Decreasing => Some(1.0),
+        }
+    }
+
+    /// Whether the check applies in `tier`.
+    pub fn applies(&self, tier: Tier) -> bool {
+        self.tiers.as_ref().is_none_or(|t| t.contains(&tier))
+    }
+
     /// Whether the spec is complete for its kind; the message says what is missing.
     pub fn validate(&self) -> Result<(), String> {
         let need = |v: Option<f64>, field: &str, kind: &str| match v {
@@ -175,28 +220,29 @@ impl CheckSpec {
         }
     }
 
-    /// Evaluates the check on the runs of `tier`; `None` when it does not apply (no run
+    /// Evaluates the check on the rows of `tier`; `None` when it does not apply (no row
     /// selected, another tier, or fewer than two spacings for `decreasing`/`order`).
-    pub fn evaluate(&self, runs: &[RunResult], tier: Tier) -> Option<CheckResult> {
-        if self.tiers.as_ref().is_some_and(|t| !t.contains(&tier)) {
+    pub fn evaluate<R: Checked>(&self, rows: &[R], tier: Tier) -> Option<CheckResult> {
+        if !self.applies(tier) {
             return None;
         }
-        let selected: Vec<&RunResult> = runs.iter().filter(|r| self.select.matches(r)).collect();
-        if selected.is_empty() {
+        let picked: Vec<&R> = rows.iter().filter(|r| self.select.matches(*r)).collect();
+        if picked.is_empty() {
             return None;
         }
         let name = self.display_name();
-        let diverged: Vec<String> =
-            selected.iter().filter(|r| !r.ok()).map(|r| format!("{} {}", r.slug(), r.status)).collect();
+        let diverged: Vec<String> = picked.iter().filter_map(|r| r.failure()).collect();
+        let selected: Vec<&RunResult> = picked.iter().map(|r| r.run()).collect();
+        let (metric, missing) = (self.metric.as_str(), self.missing.as_deref());
         let mut result = match self.kind()? {
-            CheckKind::Max => bound(&name, &selected, &self.metric, self.max?, |v, t| v <= t, f64::max),
-            CheckKind::Min => bound(&name, &selected, &self.metric, self.min?, |v, t| v >= t, f64::min),
+            CheckKind::Max => bound(&name, &selected, metric, self.max?, |v, t| v <= t, f64::max, missing),
+            CheckKind::Min => bound(&name, &selected, metric, self.min?, |v, t| v >= t, f64::min, missing),
             CheckKind::Equals => {
                 let want = self.value?;
                 let tol = self.tolerance.unwrap_or(0.0);
                 // The worst value is the one farthest from the expected one.
                 let far = |a: f64, b: f64| if (a - want).abs() >= (b - want).abs() { a } else { b };
-                bound(&name, &selected, &self.metric, want, |v, t| (v - t).abs() <= tol, far)
+                bound(&name, &selected, metric, want, |v, t| (v - t).abs() <= tol, far, missing)
             }
             CheckKind::Decreasing => decreasing(&name, &selected, &self.metric)?,
             CheckKind::Order => order(&name, &selected, &self.metric, self.min?)?,
@@ -209,7 +255,8 @@ impl CheckSpec {
     }
 }
 
-/// `max` / `min` / `equals`: every selected run's metric against `threshold`.
+/// `max` / `min` / `equals`: every selected run's metric against `threshold`; `missing`
+/// is the note when the metric is missing or not finite somewhere.
 fn bound(
     name: &str,
     runs: &[&RunResult],
@@ -217,6 +264,7 @@ fn bound(
     threshold: f64,
     ok: impl Fn(f64, f64) -> bool,
     worst: impl Fn(f64, f64) -> f64,
+    missing_note: Option<&str>,
 ) -> CheckResult {
     let mut value: Option<f64> = None;
     let mut pass = true;
@@ -230,8 +278,12 @@ fn bound(
             None => missing.push(r.slug()),
         }
     }
-    let note =
-        (!missing.is_empty()).then(|| format!("`{metric}` missing or not finite in {}", missing.join(", ")));
+    let note = (!missing.is_empty()).then(|| {
+        missing_note.map_or_else(
+            || format!("`{metric}` missing or not finite in {}", missing.join(", ")),
+            str::to_string,
+        )
+    });
     CheckResult {
         name: name.to_string(),
         value,
@@ -308,7 +360,7 @@ fn order(name: &str, runs: &[&RunResult], metric: &str, min: f64) -> Option<Chec
 }
 
 /// Evaluates every applicable check of a case.
-pub fn evaluate_all(specs: &[CheckSpec], runs: &[RunResult], tier: Tier) -> Vec<CheckResult> {
+pub fn evaluate_all<R: Checked>(specs: &[CheckSpec], runs: &[R], tier: Tier) -> Vec<CheckResult> {
     specs.iter().filter_map(|c| c.evaluate(runs, tier)).collect()
 }
 

@@ -11,13 +11,20 @@ const TICKS: u64 = 1000;
 #[derive(Debug, Clone)]
 pub struct Progress {
     multi: MultiProgress,
+    /// Whether [`Progress::println`] prints.
+    lines: bool,
 }
 
 impl Progress {
-    /// A display on stderr, or a hidden one.
+    /// A display on stderr, or a hidden one (whose lines still go to stderr).
     pub fn new(visible: bool) -> Self {
         let target = if visible { ProgressDrawTarget::stderr() } else { ProgressDrawTarget::hidden() };
-        Progress { multi: MultiProgress::with_draw_target(target) }
+        Progress { multi: MultiProgress::with_draw_target(target), lines: true }
+    }
+
+    /// No bars and no lines.
+    pub fn silent() -> Self {
+        Progress { multi: MultiProgress::with_draw_target(ProgressDrawTarget::hidden()), lines: false }
     }
 
     /// A bar counting the runs of a case.
@@ -47,8 +54,11 @@ impl Progress {
     }
 
     /// Prints a line above the bars, or plainly to stderr when the bars are hidden (so CI
-    /// logs still show one line per run).
+    /// logs still show one line per run); nothing when [`Progress::silent`].
     pub fn println(&self, line: &str) {
+        if !self.lines {
+            return;
+        }
         if self.multi.is_hidden() {
             eprintln!("{line}");
         } else {

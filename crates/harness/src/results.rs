@@ -1,11 +1,9 @@
 //! The results files (DESIGN.md "Results files"): `reports/<case>/results.json`,
-//! `reports/summary.json`, and the provenance/case copies the report pages read.
+//! `reports/summary.json`, and where they are found.
 
-use crate::case::Case;
-use crate::checks::CheckResult;
-use crate::provenance::Provenance;
 use serde::{Deserialize, Deserializer, Serialize};
 use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
 
 /// One run of the sweep, as it appears in `results.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -96,14 +94,19 @@ pub struct CaseResults {
 impl CaseResults {
     /// Number of passed and failed checks.
     pub fn counts(&self) -> (usize, usize) {
-        let passed = self.checks.iter().filter(|c| c.pass).count();
-        (passed, self.checks.len() - passed)
+        check_counts(&self.checks)
     }
 
     /// Whether every check passed.
     pub fn pass(&self) -> bool {
-        self.checks.iter().all(|c| c.pass)
+        check_counts(&self.checks).1 == 0
     }
+}
+
+/// Passed and failed checks among `checks`.
+pub fn check_counts(checks: &[CheckResult]) -> (usize, usize) {
+    let passed = checks.iter().filter(|c| c.pass).count();
+    (passed, checks.len() - passed)
 }
 
 /// One case in `reports/summary.json`.
@@ -161,6 +164,11 @@ pub struct Summary {
 }
 
 impl Summary {
+    /// The summary of the cases' results (`reports/summary.json`).
+    pub fn of(results: &[CaseResults]) -> Self {
+        Summary::new(results.iter().map(CaseSummary::of).collect())
+    }
+
     /// Builds the summary from per-case summaries (sorted by case name).
     pub fn new(mut cases: Vec<CaseSummary>) -> Self {
         cases.sort_by(|a, b| a.case.cmp(&b.case));
@@ -171,16 +179,36 @@ impl Summary {
     }
 }
 
-/// Side file `reports/<case>/provenance.json`: the case file as run and where/when/what
-/// produced the results (kept out of results.json to keep that contract exact).
+/// A check's outcome, as written to `results.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct CaseRecord {
-    /// The case file as it was when the results were produced.
-    pub case: Case,
-    /// Machine, commit, date.
-    pub provenance: Provenance,
-    /// SHA-256 of each run's effective scene, by slug.
-    pub scene_hashes: BTreeMap<String, String>,
+pub struct CheckResult {
+    /// Check name.
+    pub name: String,
+    /// Measured value (worst over the selected runs); `null` when it could not be measured.
+    pub value: Option<f64>,
+    /// The bound it is compared with (`decreasing`: 1, the largest allowed ratio).
+    pub threshold: Option<f64>,
+    /// Whether it passed.
+    pub pass: bool,
+    /// Why it failed when not because of the value (diverged run, missing metric).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+/// The case directories `<out>/<case>` that hold a `results.json`, sorted by name; only
+/// those named in `cases` when given (other directories, e.g. a stale case or
+/// `work_precision/`, are left out).
+pub fn case_dirs(out: &Path, cases: Option<&[String]>) -> Vec<PathBuf> {
+    let Ok(rd) = std::fs::read_dir(out) else { return Vec::new() };
+    let wanted = |p: &Path| {
+        cases.is_none_or(|names| p.file_name().is_some_and(|n| names.iter().any(|c| n == c.as_str())))
+    };
+    let mut dirs: Vec<PathBuf> = rd
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| wanted(p) && p.join("results.json").is_file())
+        .collect();
+    dirs.sort();
+    dirs
 }
 
 fn nan_map<'de, D: Deserializer<'de>>(d: D) -> Result<BTreeMap<String, f64>, D::Error> {

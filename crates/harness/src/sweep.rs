@@ -1,14 +1,17 @@
-//! Expands a case into runs (tier spacings × presets) and executes one run in-process.
+//! Expands a case into runs (tier spacings × presets): the scene, slug and hash of each.
 
-use crate::cache::{CachedProbes, RunRecord, sha256_hex};
-use crate::case::{Case, Tier};
+use crate::cache::sha256_hex;
+use crate::case::Case;
 use crate::error::{HarnessError, Result};
 use crate::patch::merge_patch;
 use crate::results::slug;
+use crate::tier::Tier;
 
-/// One parameter point of a sweep, with its effective scene.
+/// One parameter point of a sweep (or of a study), with its effective scene.
 #[derive(Debug, Clone)]
 pub struct RunSpec {
+    /// The case (or study) the run belongs to, for error messages.
+    pub case: String,
     /// Scheme (the key of the scene's `scheme` object).
     pub scheme: String,
     /// Preset name.
@@ -25,6 +28,40 @@ pub struct RunSpec {
     /// SHA-256 of the build fingerprint and the canonical scene JSON: a cached run is
     /// reused only for the same scene computed by the same build of the solver.
     pub hash: String,
+}
+
+impl RunSpec {
+    /// The run `slug` of `case` (or of a study) with preset `preset` at spacing `dx` and the
+    /// checked `scene`, which it canonicalises and hashes.
+    pub fn new(case: &str, slug: String, preset: &str, dx: f64, scene: meniscus::Scene) -> Result<RunSpec> {
+        let canonical = serde_json::to_value(&scene)
+            .map_err(|e| HarnessError::case(case, format!("run {slug}: scene does not serialise: {e}")))?;
+        let hash = sha256_hex(&format!("{}\n{canonical}", build_fingerprint()));
+        Ok(RunSpec {
+            case: case.to_string(),
+            scheme: scene.scheme.key().to_string(),
+            preset: preset.to_string(),
+            dx,
+            slug,
+            scene,
+            scene_json: canonical,
+            hash,
+        })
+    }
+
+    /// [`RunSpec::new`] from the scene's JSON, which the solver's parser checks (its error
+    /// names the case and the run).
+    pub fn from_json(
+        case: &str,
+        slug: String,
+        preset: &str,
+        dx: f64,
+        scene: &serde_json::Value,
+    ) -> Result<RunSpec> {
+        let parsed = meniscus::Scene::from_json(&scene.to_string())
+            .map_err(|source| HarnessError::Scene { case: case.to_string(), run: slug.clone(), source })?;
+        RunSpec::new(case, slug, preset, dx, parsed)
+    }
 }
 
 /// The effective scene JSON of `preset` at spacing `dx`: template, merge patch, `dx`, and
@@ -56,16 +93,7 @@ pub fn spec(case: &Case, preset: &str, dx: f64) -> Result<RunSpec> {
         .as_object()
         .and_then(|m| m.keys().next().cloned())
         .unwrap_or_else(|| case.scheme.clone());
-    let slug = slug(&scheme, preset, dx);
-    let scene = meniscus::Scene::from_json(&value.to_string()).map_err(|source| HarnessError::Scene {
-        case: case.case.clone(),
-        run: slug.clone(),
-        source,
-    })?;
-    let canonical = serde_json::to_value(&scene)
-        .map_err(|e| HarnessError::case(&case.case, format!("run {slug}: scene does not serialise: {e}")))?;
-    let hash = sha256_hex(&format!("{}\n{canonical}", build_fingerprint()));
-    Ok(RunSpec { scheme, preset: preset.to_string(), dx, slug, scene, scene_json: canonical, hash })
+    RunSpec::from_json(&case.case, slug(&scheme, preset, dx), preset, dx, &value)
 }
 
 /// SHA-256 of the running executable (which contains the solver), computed once: any
@@ -102,40 +130,14 @@ pub fn expand(case: &Case, tier: Tier) -> Result<Vec<RunSpec>> {
     Ok(out)
 }
 
-/// Runs `spec` through the solver (a diverged run is a record with status `diverged`).
-pub fn execute(spec: &RunSpec, observer: &mut dyn meniscus::Observer) -> Result<RunRecord> {
-    let report = meniscus::run(&spec.scene, observer).map_err(|source| HarnessError::Scene {
-        case: spec.scene.name.clone(),
-        run: spec.slug.clone(),
-        source,
-    })?;
-    Ok(RunRecord {
-        completed: true,
-        slug: spec.slug.clone(),
-        scheme: spec.scheme.clone(),
-        preset: spec.preset.clone(),
-        dx: spec.dx,
-        scene_hash: spec.hash.clone(),
-        scene: spec.scene_json.clone(),
-        summary: report.summary,
-        probes: CachedProbes::from(report.probes),
-        snapshots: report.snapshots.iter().map(crate::snapshots::Snapshot::from).collect(),
-    })
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use std::path::Path;
-
-    fn case() -> Case {
-        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
-            .unwrap()
-    }
+    use crate::case::testing::committed;
 
     #[test]
     fn expands_tier_into_slugged_runs() {
-        let runs = expand(&case(), Tier::Quick).unwrap();
+        let runs = expand(&committed("elliptical_drop"), Tier::Quick).unwrap();
         let slugs: Vec<&str> = runs.iter().map(|r| r.slug.as_str()).collect();
         assert_eq!(
             slugs,
@@ -163,7 +165,7 @@ mod tests {
         assert_eq!(runs[0].hash.len(), 64);
         assert_ne!(runs[0].hash, runs[1].hash);
         assert_ne!(runs[0].hash, runs[4].hash);
-        let full = expand(&case(), Tier::Full).unwrap();
+        let full = expand(&committed("elliptical_drop"), Tier::Full).unwrap();
         assert_eq!(full.len(), 16);
         // Δt scales with dx below the template's 0.02 (CFL number kept), not above it.
         let dt = |r: &RunSpec| r.scene_json["time"]["step"]["fixed"].as_f64().unwrap();
@@ -174,7 +176,7 @@ mod tests {
 
     #[test]
     fn hash_is_stable_and_follows_the_scene() {
-        let c = case();
+        let c = committed("elliptical_drop");
         let a = spec(&c, "paper", 0.04).unwrap();
         assert_eq!(a.hash, spec(&c, "paper", 0.04).unwrap().hash);
         let mut changed = c.clone();
@@ -184,7 +186,7 @@ mod tests {
 
     #[test]
     fn bad_preset_patch_names_the_run() {
-        let mut c = case();
+        let mut c = committed("elliptical_drop");
         c.sweep.presets[1].patch = serde_json::json!({"fluid": {"density": -1.0}});
         let e = expand(&c, Tier::Quick).unwrap_err().to_string();
         assert!(e.contains("isph-tuned_dx0.04") && e.contains("density"), "{e}");

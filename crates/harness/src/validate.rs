@@ -2,8 +2,7 @@
 //! orders and checks, write the results files and render the report.
 
 use crate::baseline::Comparison;
-use crate::cache::{self, RunRecord};
-use crate::case::{self, Case, Tier};
+use crate::case::{self, Case, CaseRecord};
 use crate::checks::evaluate_all;
 use crate::error::{HarnessError, Result};
 use crate::fit::fit_power_law;
@@ -12,12 +11,12 @@ use crate::metrics;
 use crate::progress::Progress;
 use crate::provenance::Provenance;
 use crate::report::{self, Baseline, RenderOptions};
-use crate::results::{CaseRecord, CaseResults, Convergence, RunResult, Summary};
+use crate::results::{CaseResults, Convergence, RunResult};
+use crate::runner::{Job, Ran, Runner};
 use crate::sweep::{self, RunSpec};
+use crate::tier::Tier;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::sync::Mutex;
-use std::sync::atomic::{AtomicUsize, Ordering};
+use std::path::PathBuf;
 
 /// Options of a validation.
 #[derive(Debug, Clone)]
@@ -62,171 +61,109 @@ impl Outcome {
     }
 }
 
-/// The names of the case files in `validation_dir` (their file stems), sorted.
-pub fn known_cases(validation_dir: &Path) -> Result<Vec<String>> {
-    Ok(case::discover(validation_dir, &[])?
-        .iter()
-        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
-        .collect())
-}
-
 /// Runs the validation described by `opts`; failed checks are results, not errors.
 pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     let paths = case::discover(&opts.validation_dir, &opts.cases)?;
     let cases: Vec<Case> = paths.iter().map(|p| Case::load(p)).collect::<Result<_>>()?;
-    let known = known_cases(&opts.validation_dir)?;
+    let known = case::known_cases(&opts.validation_dir)?;
     // Read the baseline before running anything: a wrong path fails at once, and a baseline
     // that is the output directory itself still holds the previous results.
     let baseline = opts.baseline.as_deref().map(|dir| Baseline::load(dir, Some(&known))).transpose()?;
-    let progress = Progress::new(opts.progress);
+    let runner = Runner::new(Progress::new(opts.progress), opts.force, opts.jobs);
     let provenance = Provenance::collect(&opts.workspace);
     let mut outcome = Outcome { results: Vec::new(), executed: 0, reused: 0, comparison: None };
     for case in &cases {
-        let specs = sweep::expand(case, opts.tier)?;
+        let jobs: Vec<Job> = sweep::expand(case, opts.tier)?.into_iter().map(Job::new).collect();
         let case_dir = opts.out.join(&case.case);
-        let bar = progress.case_bar(&case.case, specs.len());
-        let (records, executed) = run_specs(&specs, &case_dir, opts, &progress, &bar)?;
-        bar.finish_with_message(format!("{executed} run, {} cached", specs.len() - executed));
-        outcome.executed += executed;
-        outcome.reused += specs.len() - executed;
-        for r in records.iter().filter(|r| !r.snapshots.is_empty()) {
+        let ran = runner.run(&case_dir, Some(&case.case), &jobs, |i, ran| {
+            let spec = &jobs[i].spec;
+            let line = match &ran {
+                Ran::Finished { record, reused } => format!(
+                    "  {} {} ({:.1} s{})",
+                    spec.slug,
+                    record.status(),
+                    record.summary.wall_s,
+                    if *reused { ", cached" } else { "" }
+                ),
+                Ran::Panicked { .. } => format!("  {} {}", spec.slug, ran.status()),
+            };
+            Ok((ran, line))
+        })?;
+        for r in ran.iter().filter_map(Ran::record).filter(|r| !r.snapshots.is_empty()) {
             let file = crate::snapshots::SnapshotFile {
                 slug: r.slug.clone(),
                 preset: r.preset.clone(),
                 dx: r.dx,
-                status: status(r),
+                status: r.status(),
                 frames: r.snapshots.clone(),
             };
             crate::snapshots::store(&case_dir, &file)?;
         }
-        let results = assemble(case, opts.tier, &records)?;
+        let runs = jobs
+            .iter()
+            .zip(&ran)
+            .map(|(job, ran)| run_result(case, &job.spec, ran))
+            .collect::<Result<_>>()?;
+        let results = assemble(case, opts.tier, runs);
         let record = CaseRecord {
             case: case.clone(),
             provenance: provenance.clone(),
-            scene_hashes: records.iter().map(|r| (r.slug.clone(), r.scene_hash.clone())).collect(),
+            scene_hashes: jobs.iter().map(|j| (j.spec.slug.clone(), j.spec.hash.clone())).collect(),
         };
         io::write_json(&case_dir.join("results.json"), &results)?;
         io::write_json(&case_dir.join("provenance.json"), &record)?;
         let (passed, failed) = results.counts();
-        progress.println(&format!(
+        runner.progress().println(&format!(
             "{}: {passed} checks passed, {failed} failed -> {}",
             case.case,
             case_dir.join("index.html").display()
         ));
         outcome.results.push(results);
     }
-    let rendered = report::render(&opts.out, &RenderOptions { cases: Some(known), baseline })?;
+    let tally = runner.tally();
+    (outcome.executed, outcome.reused) = (tally.executed, tally.reused);
+    let extras = crate::stability::extra_page(&opts.out).into_iter().collect();
+    let rendered = report::render(&opts.out, &RenderOptions { cases: Some(known), baseline, extras })?;
     outcome.comparison = rendered.comparison;
     Ok(outcome)
 }
 
-/// Runs (or reuses) every spec of a case; returns the records in spec order and how many
-/// were executed. With `jobs > 1`, that many runs go concurrently, each in its own rayon
-/// pool with an equal share of the threads (small runs, like the channels' few thousand
-/// particles, gain nothing from a second thread: their steps are bound by synchronisation).
-fn run_specs(
-    specs: &[RunSpec],
-    case_dir: &Path,
-    opts: &ValidateOptions,
-    progress: &Progress,
-    bar: &indicatif::ProgressBar,
-) -> Result<(Vec<RunRecord>, usize)> {
-    let slots: Vec<Mutex<Option<Result<RunRecord>>>> = specs.iter().map(|_| Mutex::new(None)).collect();
-    let mut todo = Vec::new();
-    for (i, spec) in specs.iter().enumerate() {
-        let cached = if opts.force {
-            None
-        } else {
-            cache::load(&cache::record_path(case_dir, &spec.slug), &spec.hash)
-        };
-        match cached {
-            Some(r) => {
-                *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(Ok(r));
-                bar.inc(1);
-            }
-            None => todo.push(i),
-        }
-    }
-    let next = AtomicUsize::new(0);
-    let jobs = opts.jobs.clamp(1, todo.len().max(1));
-    let threads = (rayon::current_num_threads() / jobs).max(1);
-    let worker = || {
-        let pool = (jobs > 1).then(|| rayon::ThreadPoolBuilder::new().num_threads(threads).build());
-        loop {
-            let k = next.fetch_add(1, Ordering::Relaxed);
-            let Some(&i) = todo.get(k) else { break };
-            let spec = &specs[i];
-            let mut run_bar = progress.run_bar(&spec.slug);
-            let result = match &pool {
-                Some(Ok(pool)) => pool.install(|| sweep::execute(spec, &mut run_bar)),
-                _ => sweep::execute(spec, &mut run_bar),
-            }
-            .and_then(|record| {
-                cache::store(&cache::record_path(case_dir, &spec.slug), &record)?;
-                Ok(record)
-            });
-            run_bar.finish();
-            if let Ok(r) = &result {
-                progress.println(&format!("  {} {} ({:.1} s)", r.slug, status(r), r.summary.wall_s));
-            }
-            bar.inc(1);
-            *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
-        }
+/// A run of `case` as its results file shows it: the metrics of its probes against the
+/// case's reference; none when the solver panicked.
+pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
+    let mut run = RunResult {
+        scheme: spec.scheme.clone(),
+        preset: spec.preset.clone(),
+        dx: spec.dx,
+        particles: 0,
+        steps: 0,
+        wall_s: 0.0,
+        status: ran.status(),
+        metrics: BTreeMap::new(),
+        series: BTreeMap::new(),
     };
-    if jobs == 1 {
-        worker();
-    } else {
-        std::thread::scope(|s| {
-            for _ in 0..jobs {
-                s.spawn(worker);
-            }
-        });
-    }
-    let records = slots
-        .into_iter()
-        .map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()).expect("every slot is filled"))
-        .collect::<Result<Vec<_>>>()?;
-    Ok((records, todo.len()))
-}
-
-/// The run's status string (DESIGN.md): `ok` or `diverged: <cause at step/time>`.
-fn status(r: &RunRecord) -> String {
-    if r.summary.status == meniscus::Status::Ok && r.summary.error.is_none() {
-        "ok".to_string()
-    } else {
-        format!("diverged: {}", r.summary.error.as_deref().unwrap_or("unknown cause"))
-    }
-}
-
-/// Builds a case's results from its run records: metrics, orders and checks.
-pub fn assemble(case: &Case, tier: Tier, records: &[RunRecord]) -> Result<CaseResults> {
-    let mut runs = Vec::with_capacity(records.len());
-    for r in records {
+    if let Some(r) = ran.record() {
         let probes = meniscus::ProbeRecord::from(r.probes.clone());
         let measured = metrics::compute(&case.reference, &r.scene, &probes, r.summary.particles)
             .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
-        runs.push(RunResult {
-            scheme: r.scheme.clone(),
-            preset: r.preset.clone(),
-            dx: r.dx,
-            particles: r.summary.particles,
-            steps: r.summary.steps,
-            wall_s: r.summary.wall_s,
-            status: status(r),
-            metrics: measured.metrics,
-            series: measured.series,
-        });
+        (run.particles, run.steps, run.wall_s) = (r.summary.particles, r.summary.steps, r.summary.wall_s);
+        (run.metrics, run.series) = (measured.metrics, measured.series);
     }
+    Ok(run)
+}
+
+/// Builds a case's results from its runs: orders and checks.
+pub fn assemble(case: &Case, tier: Tier, runs: Vec<RunResult>) -> CaseResults {
     let convergence = convergence(case, &runs);
     let checks = evaluate_all(&case.checks, &runs, tier);
-    Ok(CaseResults {
+    CaseResults {
         case: case.case.clone(),
         scheme: case.scheme.clone(),
         tier: tier.name().to_string(),
         runs,
         convergence,
         checks,
-    })
+    }
 }
 
 /// Observed orders of the case's convergence metrics, from the runs that completed. The
@@ -269,20 +206,27 @@ pub fn convergence(case: &Case, runs: &[RunResult]) -> BTreeMap<String, Converge
     out
 }
 
-/// Rebuilds `summary.json` from the results present in `out` (see [`report::render_all`]).
-pub fn summary_of(results: &[CaseResults]) -> Summary {
-    Summary::new(results.iter().map(crate::results::CaseSummary::of).collect())
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::cache::CachedProbes;
+    use crate::cache::{CachedProbes, RunRecord};
     use crate::io::testing::Scratch;
 
     fn drop_case() -> Case {
-        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
-            .unwrap()
+        crate::case::testing::committed("elliptical_drop")
+    }
+
+    /// The drop's results from `records` (as the runner would hand them over).
+    fn results(records: Vec<RunRecord>) -> CaseResults {
+        let case = drop_case();
+        let runs = records
+            .into_iter()
+            .map(|r| {
+                let spec = sweep::spec(&case, &r.preset, r.dx).unwrap();
+                run_result(&case, &spec, &Ran::Finished { record: Box::new(r), reused: false }).unwrap()
+            })
+            .collect();
+        assemble(&case, Tier::Quick, runs)
     }
 
     /// A synthetic record whose b error is `c dx^2` (a exact): no solver run.
@@ -324,7 +268,7 @@ mod tests {
             synthetic("paper", 0.02, 5.0, 7860),
             synthetic("tuned", 0.02, 1.0, 7860),
         ];
-        let res = assemble(&drop_case(), Tier::Quick, &recs).unwrap();
+        let res = results(recs);
         assert_eq!(res.tier, "quick");
         assert_eq!(res.runs.len(), 4);
         let conv = &res.convergence["b_rel_err_max"];
@@ -339,7 +283,7 @@ mod tests {
             synthetic("tuned", 0.04, 1.0, 1976),
             synthetic("tuned", 0.02, 1.0, 7860),
         ];
-        let conv = assemble(&drop_case(), Tier::Quick, &partial).unwrap().convergence;
+        let conv = results(partial).convergence;
         assert_eq!(conv["b_rel_err_max"].preset, "tuned");
         assert!((conv["b_rel_err_max"].order - 2.0).abs() < 1e-9);
         let names: Vec<&str> = res.checks.iter().map(|c| c.name.as_str()).collect();
@@ -359,12 +303,17 @@ mod tests {
         bad.summary.status = meniscus::Status::Diverged;
         bad.summary.error = Some("diverged in stage `ppe` at step 7".into());
         let recs = vec![synthetic("paper", 0.04, 5.0, 1976), bad];
-        let res = assemble(&drop_case(), Tier::Quick, &recs).unwrap();
+        let res = results(recs);
         assert!(res.runs[1].status.starts_with("diverged: "));
         let b = res.checks.iter().find(|c| c.name.starts_with("b error (moments")).unwrap();
         assert!(!b.pass && b.note.as_deref().unwrap_or("").contains("diverged"));
         assert!(!res.pass());
         assert!(!res.convergence.contains_key("b_rel_err_max"), "diverged runs are not fitted");
+        // A run whose solver panicked is a diverged run without metrics.
+        let spec = sweep::spec(&drop_case(), "tuned", 0.02).unwrap();
+        let panicked = run_result(&drop_case(), &spec, &Ran::Panicked { message: "boom".into() }).unwrap();
+        assert_eq!(panicked.status, "diverged: the solver panicked: boom");
+        assert!(panicked.metrics.is_empty() && panicked.particles == 0 && !panicked.ok());
     }
 
     /// A tiny real solver run (dx = 0.1, two steps) through the whole pipeline, twice:
@@ -412,7 +361,7 @@ mod tests {
         assert_eq!((second.executed, second.reused), (0, 1));
         let index = std::fs::read_to_string(opts.out.join("index.html")).unwrap();
         assert!(index.contains("tiny_drop/index.html") && !index.contains("stale_case"));
-        let summary: Summary = io::read_json(&opts.out.join("summary.json")).unwrap();
+        let summary: crate::results::Summary = io::read_json(&opts.out.join("summary.json")).unwrap();
         assert_eq!(summary.cases.len(), 1);
         assert_eq!(second.results[0].runs, first.results[0].runs);
         case.scene["time"]["end"] = serde_json::json!(0.0006);

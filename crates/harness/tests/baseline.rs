@@ -102,7 +102,9 @@ fn marks_appear_in_summary_md_and_html() {
     std::fs::write(out.join("old_case/results.json"), "not even JSON").unwrap();
     let cases = vec!["elliptical_drop".to_string()];
     let base = Baseline::load(&fixtures().join("base"), Some(&cases)).unwrap();
-    let rendered = report::render(&out, &RenderOptions { cases: Some(cases), baseline: Some(base) }).unwrap();
+    let rendered =
+        report::render(&out, &RenderOptions { cases: Some(cases), baseline: Some(base), extras: Vec::new() })
+            .unwrap();
     assert_eq!(rendered.results.len(), 1);
     assert!(rendered.comparison.unwrap().tally().regressed());
 

@@ -2,7 +2,8 @@
 
 use super::FigureFile;
 use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
-use crate::results::{CaseRecord, CaseResults, RunResult, Summary};
+use crate::case::CaseRecord;
+use crate::results::{CaseResults, CheckResult, RunResult, Summary};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
 const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1200px;color:#222}\
@@ -182,6 +183,24 @@ pub(crate) fn pass_cell(pass: bool) -> Markup {
     html! { td class=(if pass { "pass" } else { "fail" }) { (if pass { "PASS" } else { "FAIL" }) } }
 }
 
+/// The table of checks: name, value and threshold (written by `number`), verdict, note.
+pub(crate) fn checks_table(checks: &[CheckResult], number: fn(f64) -> String) -> Markup {
+    html! {
+        table {
+            tr { th class="l" { "check" } th { "value" } th { "threshold" } th { "result" } th class="l" { "note" } }
+            @for c in checks {
+                tr {
+                    td class="l" { (c.name) }
+                    td { (c.value.map_or("—".to_string(), number)) }
+                    td { (c.threshold.map_or("—".to_string(), number)) }
+                    (pass_cell(c.pass))
+                    td class="l" { (c.note.as_deref().unwrap_or("")) }
+                }
+            }
+        }
+    }
+}
+
 pub(crate) fn page(title: &str, body: Markup) -> String {
     html! {
         (DOCTYPE)
@@ -254,18 +273,7 @@ pub fn case_page(
             }
         }
         h2 { "Checks" }
-        table {
-            tr { th class="l" { "check" } th { "value" } th { "threshold" } th { "result" } th class="l" { "note" } }
-            @for c in &results.checks {
-                tr {
-                    td class="l" { (c.name) }
-                    td { (c.value.map_or("—".to_string(), |v| format!("{v:.4e}"))) }
-                    td { (c.threshold.map_or("—".to_string(), |v| format!("{v:.4e}"))) }
-                    (pass_cell(c.pass))
-                    td class="l" { (c.note.as_deref().unwrap_or("")) }
-                }
-            }
-        }
+        (checks_table(&results.checks, |v| format!("{v:.4e}")))
         @if let Some(cmp) = comparison {
             @if let Some(case) = cmp.case(&results.case) { (baseline_section(cmp, case)) }
         }
@@ -417,18 +425,9 @@ pub struct ExtraPage {
     pub pass: bool,
 }
 
-/// `reports/index.html`: one row per case; with a comparison, a "vs baseline" column.
+/// `reports/index.html`: one row per case (with a comparison, a "vs baseline" column), then
+/// links to the `extras` pages.
 pub fn index_page(
-    results: &[CaseResults],
-    records: &[Option<&CaseRecord>],
-    summary: &Summary,
-    comparison: Option<&Comparison>,
-) -> String {
-    index_page_with(results, records, summary, comparison, &[])
-}
-
-/// [`index_page`] with links to the `extras` pages after the table of cases.
-pub fn index_page_with(
     results: &[CaseResults],
     records: &[Option<&CaseRecord>],
     summary: &Summary,

@@ -7,7 +7,8 @@ use super::html::{
     format_change, format_metric, format_order, format_ratio, key_errors, key_order, resolutions,
 };
 use crate::baseline::{CaseComparison, Comparison, Mark};
-use crate::results::{CaseRecord, CaseResults, Summary};
+use crate::case::CaseRecord;
+use crate::results::{CaseResults, Summary};
 use std::fmt::Write;
 
 /// Makes `text` safe inside a table cell (no pipes, no line breaks).

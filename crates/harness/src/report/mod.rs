@@ -10,11 +10,13 @@ pub mod html;
 pub mod markdown;
 pub mod plots;
 
+pub use html::ExtraPage;
+
 use crate::baseline::{self, Comparison, NoiseBand};
-use crate::case::Figure;
+use crate::case::{CaseRecord, Figure};
 use crate::error::Result;
 use crate::io;
-use crate::results::{CaseRecord, CaseResults, RunResult};
+use crate::results::{CaseResults, RunResult, Summary, case_dirs};
 use std::path::{Path, PathBuf};
 
 /// A figure written next to a case page.
@@ -159,20 +161,11 @@ pub fn collect(out: &Path) -> Result<Vec<(CaseResults, Option<CaseRecord>)>> {
     collect_cases(out, None)
 }
 
-/// Like [`collect`], restricted to the directories named in `cases` when given (other
-/// directories, e.g. a stale case or `work_precision/`, are not even read).
+/// Like [`collect`], restricted to the directories named in `cases` when given (see
+/// [`case_dirs`]).
 pub fn collect_cases(out: &Path, cases: Option<&[String]>) -> Result<Vec<(CaseResults, Option<CaseRecord>)>> {
     let mut found = Vec::new();
-    let Ok(rd) = std::fs::read_dir(out) else { return Ok(found) };
-    let wanted = |p: &Path| {
-        cases.is_none_or(|names| p.file_name().is_some_and(|n| names.iter().any(|c| n == c.as_str())))
-    };
-    let mut dirs: Vec<_> = rd
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| wanted(p) && p.join("results.json").is_file())
-        .collect();
-    dirs.sort();
-    for d in dirs {
+    for d in case_dirs(out, cases) {
         let results: CaseResults = io::read_json(&d.join("results.json"))?;
         let record: Option<CaseRecord> = io::read_json(&d.join("provenance.json")).ok();
         found.push((results, record));
@@ -204,6 +197,8 @@ pub struct RenderOptions {
     pub cases: Option<Vec<String>>,
     /// Compare with this baseline.
     pub baseline: Option<Baseline>,
+    /// Pages beside the cases that the index links (the stability envelope's).
+    pub extras: Vec<ExtraPage>,
 }
 
 /// What [`render`] produced.
@@ -222,7 +217,8 @@ pub fn render_all(out: &Path) -> Result<Vec<CaseResults>> {
 }
 
 /// Renders every case page, `summary.json`, `summary.md` and `index.html` in `out` from the
-/// results files there (restricted to `opts.cases`), compared with `opts.baseline`.
+/// results files there (restricted to `opts.cases`), compared with `opts.baseline`; the
+/// index links `opts.extras`.
 pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
     let found = collect_cases(out, opts.cases.as_deref())?;
     let results: Vec<CaseResults> = found.iter().map(|f| f.0.clone()).collect();
@@ -231,12 +227,10 @@ pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
     for (results, record) in &found {
         render_case(&out.join(&results.case), results, record.as_ref(), comparison.as_ref())?;
     }
-    let summary = crate::validate::summary_of(&results);
+    let summary = Summary::of(&results);
     io::write_json(&out.join("summary.json"), &summary)?;
     let records: Vec<Option<&CaseRecord>> = found.iter().map(|f| f.1.as_ref()).collect();
-    let extras: Vec<html::ExtraPage> =
-        crate::stability::load(out).map(|s| s.index_entry()).into_iter().collect();
-    let page = html::index_page_with(&results, &records, &summary, comparison.as_ref(), &extras);
+    let page = html::index_page(&results, &records, &summary, comparison.as_ref(), &opts.extras);
     io::write_atomic(&out.join("index.html"), page.as_bytes())?;
     let md = markdown::summary(&results, &records, &summary, comparison.as_ref());
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
@@ -246,7 +240,6 @@ pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::case::Case;
     use crate::io::testing::Scratch;
     use crate::provenance::Provenance;
 
@@ -284,9 +277,7 @@ mod tests {
         let out = dir.path();
         let results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
         io::write_json(&out.join("elliptical_drop/results.json"), &results).unwrap();
-        let case =
-            Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
-                .unwrap();
+        let case = crate::case::testing::committed("elliptical_drop");
         let record = CaseRecord {
             case,
             provenance: Provenance {
@@ -353,9 +344,7 @@ mod tests {
     #[test]
     fn snapshot_figures_pair_the_presets_per_time() {
         let dir = Scratch::new("report-snapshots");
-        let case =
-            Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/rotating_square.json"))
-                .unwrap();
+        let case = crate::case::testing::committed("rotating_square");
         let mut results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
         results.case = "rotating_square".into();
         results.runs.truncate(2);

@@ -5,6 +5,7 @@ use crate::error::{HarnessError, Result};
 use crate::fit::fit_power_law;
 use crate::results::RunResult;
 use plotters::coord::Shift;
+use plotters::coord::combinators::LogCoord;
 use plotters::prelude::*;
 
 /// Figure size in pixels.
@@ -85,6 +86,41 @@ fn builder<'a, 'b>(
     b.caption(title, ("sans-serif", 18)).margin(12).x_label_area_size(40).y_label_area_size(70);
     b
 }
+
+/// An axis of a chart.
+#[derive(Clone, Copy, PartialEq)]
+enum Axis {
+    X,
+    Y,
+}
+
+/// A log-log chart over `x` × `y` with its mesh drawn, the axes described by `desc` and the
+/// tick labels of `powers` written as powers of ten (`1e-3`).
+fn log_log<'b, 'c>(
+    root: &DrawingArea<SVGBackend<'b>, Shift>,
+    title: &str,
+    x: (f64, f64),
+    y: (f64, f64),
+    desc: (&str, &str),
+    powers: Axis,
+) -> std::result::Result<LogLog<'c, 'b>, Box<dyn std::fmt::Debug>> {
+    let mut chart = builder(root, title)
+        .build_cartesian_2d((x.0..x.1).log_scale(), (y.0..y.1).log_scale())
+        .map_err(boxed)?;
+    let power = |v: &f64| format!("{v:.0e}");
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(desc.0).y_desc(desc.1);
+    if powers == Axis::X {
+        mesh.x_label_formatter(&power);
+    } else {
+        mesh.y_label_formatter(&power);
+    }
+    mesh.draw().map_err(boxed)?;
+    Ok(chart)
+}
+
+/// A log-log chart (`'c`: its series' lifetime).
+type LogLog<'c, 'b> = ChartContext<'c, SVGBackend<'b>, Cartesian2d<LogCoord<f64>, LogCoord<f64>>>;
 
 /// Draws the series legend at `position` on a translucent white box.
 fn legend<'a, CT: plotters::coord::CoordTranslate>(
@@ -273,16 +309,7 @@ pub fn convergence(
     let (x0, x1) = log_range(lines.iter().flat_map(|l| l.3.iter().map(|p| p.0)), 1.3);
     let (y0, y1) = log_range(lines.iter().flat_map(|l| l.3.iter().map(|p| p.1)), 2.0);
     svg(|root| {
-        let mut chart = builder(root, title)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(boxed)?;
-        chart
-            .configure_mesh()
-            .x_desc("dx [m]")
-            .y_desc("relative error")
-            .y_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()
-            .map_err(boxed)?;
+        let mut chart = log_log(root, title, (x0, x1), (y0, y1), ("dx [m]", "relative error"), Axis::Y)?;
         for (label, mi, pi, pts) in &lines {
             let c = colour(*mi);
             let style = if *pi == 0 { c.stroke_width(2) } else { c.stroke_width(1) };
@@ -333,16 +360,7 @@ pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Resul
     let (x0, x1) = log_range(pts.iter().map(|p| p.2), 2.0);
     let (y0, y1) = log_range(pts.iter().map(|p| p.3), 2.0);
     svg(|root| {
-        let mut chart = builder(root, title)
-            .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
-            .map_err(boxed)?;
-        chart
-            .configure_mesh()
-            .x_desc(metric)
-            .y_desc("wall time [s]")
-            .x_label_formatter(&|v| format!("{v:.0e}"))
-            .draw()
-            .map_err(boxed)?;
+        let mut chart = log_log(root, title, (x0, x1), (y0, y1), (metric, "wall time [s]"), Axis::X)?;
         for (i, p) in presets.iter().enumerate() {
             let c = colour(i);
             let mine: Vec<&(String, f64, f64, f64)> = pts.iter().filter(|q| q.0 == *p).collect();

@@ -57,23 +57,79 @@ pub fn sig3(v: f64) -> String {
 ///
 /// `stable` may record what it ran; it is called once per tried value, in order.
 pub fn bisect(lo: f64, hi: f64, iterations: usize, mut stable: impl FnMut(f64) -> bool) -> Bracket {
-    assert!(lo > 0.0 && hi > lo, "bisect needs 0 < lo < hi, got [{lo}, {hi}]");
-    if stable(hi) {
-        return Bracket::AtLeast(hi);
+    let mut b = Bisection::new(lo, hi, iterations);
+    while let Some(value) = b.next_value() {
+        b.record(stable(value));
     }
-    if !stable(lo) {
-        return Bracket::Below(lo);
+    b.bracket().expect("a finished bisection has a bracket")
+}
+
+/// [`bisect`] one value at a time, so that several bisections can advance together (their
+/// trials run as one batch): ask [`Bisection::next_value`], run it, [`Bisection::record`]
+/// the verdict.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bisection {
+    lo: f64,
+    hi: f64,
+    /// Midpoints left.
+    left: usize,
+    state: State,
+}
+
+/// Where a bisection stands.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum State {
+    /// `hi` not tried yet.
+    Top,
+    /// `hi` unstable, `lo` not tried yet.
+    Bottom,
+    /// Stable at the first, unstable at the second; the midpoint is next.
+    Between(f64, f64),
+    /// Done.
+    Done(Bracket),
+}
+
+impl Bisection {
+    /// A bisection of `[lo, hi]` (`0 < lo < hi`) with `iterations` midpoints at most.
+    pub fn new(lo: f64, hi: f64, iterations: usize) -> Self {
+        assert!(lo > 0.0 && hi > lo, "bisect needs 0 < lo < hi, got [{lo}, {hi}]");
+        Bisection { lo, hi, left: iterations, state: State::Top }
     }
-    let (mut s, mut u) = (lo, hi);
-    for _ in 0..iterations {
-        let mid = (s * u).sqrt();
-        if stable(mid) {
-            s = mid;
-        } else {
-            u = mid;
+
+    /// The value to try next; `None` when done.
+    pub fn next_value(&self) -> Option<f64> {
+        match self.state {
+            State::Top => Some(self.hi),
+            State::Bottom => Some(self.lo),
+            State::Between(s, u) if self.left > 0 => Some((s * u).sqrt()),
+            State::Between(..) | State::Done(_) => None,
         }
     }
-    Bracket::Found { stable: s, unstable: u }
+
+    /// Records whether the value [`Bisection::next_value`] gave was stable.
+    pub fn record(&mut self, stable: bool) {
+        self.state = match self.state {
+            State::Top if stable => State::Done(Bracket::AtLeast(self.hi)),
+            State::Top => State::Bottom,
+            State::Bottom if stable => State::Between(self.lo, self.hi),
+            State::Bottom => State::Done(Bracket::Below(self.lo)),
+            State::Between(s, u) => {
+                let mid = (s * u).sqrt();
+                self.left = self.left.saturating_sub(1);
+                if stable { State::Between(mid, u) } else { State::Between(s, mid) }
+            }
+            done @ State::Done(_) => done,
+        };
+    }
+
+    /// The result, once done.
+    pub fn bracket(&self) -> Option<Bracket> {
+        match self.state {
+            State::Done(b) => Some(b),
+            State::Between(stable, unstable) if self.left == 0 => Some(Bracket::Found { stable, unstable }),
+            _ => None,
+        }
+    }
 }
 
 #[cfg(test)]

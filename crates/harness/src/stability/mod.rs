@@ -4,32 +4,43 @@
 //! - `dt_max`: the largest stable multiple k of the adaptive step (Qiu 2013 eqs. 17–18 with
 //!   α_c = α_d = 0.2, i.e. `cfl = viscous = 0.2 k`, cap `k ×` the template's), by
 //!   geometric bisection ([`bisect`]);
-//! - `re_max` (channel): the largest Reynolds number stable to the end time (1 D²/ν), by
-//!   bisection on the body force `F = 12 ν² Re / D³` at fixed ν;
+//! - `re_max` (channel, ISPH option sets): the largest Reynolds number stable to the end
+//!   time (1 D²/ν), by bisection on the body force `F = 12 ν² Re / D³` at fixed ν;
 //! - `jitter`: the initial lattice displaced by 10, 20, 30 % of Δx (`bodies[0].jitter`,
 //!   seeded);
 //! - `long_run` (drop): to t = 0.02 s, the kinetic-energy drift (the exact flow conserves it).
 //!
-//! A run is *stable* when it reaches its end time with no guard tripped and its error is
-//! within the stated bound ([`Settings::drop_bound`] on the larger of the a and b errors over
-//! the history; [`Settings::channel_bound`] on the velocity profile's L2 error at the end).
-//! Every result is a [`Row`] of `reports/stability/results.json` ([`StabilityResults`],
-//! shaped like a case's results file) and of `reports/stability/index.html` ([`page`]).
-//! Runs are cached like the cases' (`reports/stability/runs/<slug>.json`, keyed by the
-//! scene and the solver build), and `results.json` is rewritten after every row.
+//! The spacings, ranges, bounds, option sets and checks are data,
+//! `validation/studies/stability.json` ([`config`]); the bisections and the error measures
+//! are here. A run is *stable* when it reaches its end time with no guard tripped and its
+//! error is within the stated bound ([`Settings::drop_bound`] on the larger of the a and b
+//! errors over the history; [`Settings::channel_bound`] on the velocity profile's L2 error
+//! at the end). Every result is a [`Row`] of `reports/stability/results.json`
+//! ([`StabilityResults`], shaped like a case's results file) and of
+//! `reports/stability/index.html` ([`page`]). The runs go through the harness's runner
+//! ([`crate::runner`]: cached in `reports/stability/runs/<slug>.json`, panics caught,
+//! `--jobs` at a time): the three bisections of an option set advance together, one batch
+//! per step, then its jittered and long runs go as one batch; `results.json` is rewritten
+//! after every batch.
 
 pub mod bisect;
+pub mod config;
 pub mod page;
 
-use crate::cache::{self, CachedProbes, RunRecord, sha256_hex};
-use crate::case::{Case, Tier};
-use crate::checks::CheckResult;
+use crate::case::{Case, ReferenceSpec};
+use crate::checks::Checked;
 use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::patch::merge_patch;
 use crate::progress::Progress;
 use crate::provenance::Provenance;
-use bisect::{Bracket, bisect};
+use crate::report::html::format_dx;
+use crate::results::{CheckResult, RunResult, check_counts};
+use crate::runner::{Job, Ran, Runner};
+use crate::sweep::{RunSpec, effective_scene};
+use crate::tier::Tier;
+use bisect::{Bisection, Bracket, sig3};
+pub use config::{Check, Config, OptionSet, Settings};
 use serde::{Deserialize, Serialize};
 use serde_json::{Value, json};
 use std::collections::BTreeMap;
@@ -39,123 +50,8 @@ use std::time::Instant;
 /// The name of the study on the command line (`--case stability`) and its directory.
 pub const NAME: &str = "stability";
 
-/// Spacings, ranges and bounds of a stability run (the budget).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct Settings {
-    /// Spacing of the drop \[m\].
-    pub drop_dx: f64,
-    /// End time of the drop's time-step and jitter runs \[s\] (the case's 0.008 s).
-    pub drop_end: f64,
-    /// End time of the drop's long run \[s\].
-    pub long_end: f64,
-    /// Spacing of the channel \[m\].
-    pub channel_dx: f64,
-    /// End time of the channel runs in viscous times D²/ν.
-    pub channel_tau: f64,
-    /// Search range of the time-step multiple k.
-    pub dt_range: [f64; 2],
-    /// Bisection steps of k.
-    pub dt_iterations: usize,
-    /// Search range of the Reynolds number.
-    pub re_range: [f64; 2],
-    /// Bisection steps of Re.
-    pub re_iterations: usize,
-    /// Jitter fractions of Δx.
-    pub jitter: Vec<f64>,
-    /// Seed of the jitter.
-    pub seed: u64,
-    /// Stability bound on the drop's error (largest of a and b over the history).
-    pub drop_bound: f64,
-    /// Stability bound on the channel's profile L2 error at the end time.
-    pub channel_bound: f64,
-    /// Option sets run (names of [`OPTION_SETS`]).
-    pub option_sets: Vec<String>,
-}
-
-impl Settings {
-    /// The envelope as published: drop Δx = 0.04, channel D/18, about 5 minutes on 2 cores.
-    pub fn standard() -> Self {
-        Settings {
-            drop_dx: 0.04,
-            drop_end: 0.008,
-            long_end: 0.02,
-            channel_dx: 0.2 / 18.0,
-            channel_tau: 1.0,
-            // The scene rule cfl ≤ 1 caps k at 5.
-            dt_range: [0.25, 5.0],
-            dt_iterations: 4,
-            re_range: [4.0, 4000.0],
-            re_iterations: 4,
-            jitter: vec![0.1, 0.2, 0.3],
-            seed: 2026,
-            drop_bound: 0.02,
-            channel_bound: 0.05,
-            option_sets: OPTION_SETS.iter().map(|o| o.0.to_string()).collect(),
-        }
-    }
-
-    /// A few seconds in all (tests): coarse drop and channel, short runs, one option set.
-    pub fn tiny() -> Self {
-        Settings {
-            drop_dx: 0.1,
-            drop_end: 4e-4,
-            long_end: 6e-4,
-            channel_dx: 0.2 / 12.0,
-            channel_tau: 0.02,
-            dt_range: [0.5, 4.0],
-            dt_iterations: 1,
-            re_range: [4.0, 400.0],
-            re_iterations: 1,
-            jitter: vec![0.2],
-            seed: 1,
-            drop_bound: 0.02,
-            channel_bound: 0.05,
-            option_sets: vec!["xu".into()],
-        }
-    }
-}
-
-/// The option sets compared: name and description. The ISPH sets are merge patches on the
-/// scheme options of the case's template (the drop's `paper` preset, the channel's `re40`);
-/// `wcsph` replaces the scheme (see [`Base::scene`]).
-pub const OPTION_SETS: [(&str, &str); 6] = [
-    ("xu", "Xu shifting C = 0.02, symmetric pressure gradient, Qiu's divergence (Qiu 2013)"),
-    ("none", "no shifting"),
-    ("xu_difference", "Xu shifting C = 0.02 with the difference pressure gradient"),
-    ("fickian", "Fickian shifting A = 2 with the kernel-corrected divergence"),
-    (
-        WCSPH,
-        "WCSPH: the drop's wcsph_tuned preset (c0 = 10 u_max, α = 0.02, δ-SPH 0.1, corrected continuity); \
-         in the channel c0 = 10 × the Poiseuille centre-line speed F D²/(8ν), no artificial viscosity, δ-SPH 0.1",
-    ),
-    (WCSPH_XU, "wcsph with Xu shifting C = 0.02 (scheme.wcsph.shifting)"),
-];
-
-/// The scheme an option set runs.
-fn scheme_of(set: &str) -> &'static str {
-    if set.starts_with(WCSPH) { "wcsph" } else { "isph" }
-}
-
-/// The WCSPH option set's name (and the prefix of its shifted variant).
-const WCSPH: &str = "wcsph";
-
-/// The WCSPH option set with Xu shifting.
-const WCSPH_XU: &str = "wcsph_xu";
-
-/// The merge patch of option set `name` (for `wcsph` only the removal of the ISPH scheme;
-/// [`Base::scene`] adds the WCSPH options).
-fn option_patch(name: &str) -> Option<Value> {
-    Some(match name {
-        "xu" => json!({}),
-        WCSPH | WCSPH_XU => json!({"scheme": {"isph": null}}),
-        "none" => json!({"scheme": {"isph": {"shifting": null}}}),
-        "xu_difference" => json!({"scheme": {"isph": {"pressure_gradient": "difference"}}}),
-        "fickian" => json!({"scheme": {"isph": {
-            "shifting": {"xu": null, "fickian": {"coefficient": 2.0}},
-            "divergence": "corrected"}}}),
-        _ => return None,
-    })
-}
+/// α_c = α_d of Qiu 2013 eqs. 17–18: the adaptive step the multiple k scales.
+const ALPHA: f64 = 0.2;
 
 /// One solver run of a study.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -190,11 +86,18 @@ impl Trial {
             None
         }
     }
-}
 
-fn nan_map<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<BTreeMap<String, f64>, D::Error> {
-    let m: BTreeMap<String, Option<f64>> = Deserialize::deserialize(d)?;
-    Ok(m.into_iter().map(|(k, v)| (k, v.unwrap_or(f64::NAN))).collect())
+    /// The progress line of the trial.
+    fn line(&self) -> String {
+        format!(
+            "  {} {} ({:.1} s, {} steps, error {})",
+            self.slug,
+            if self.stable { "stable" } else { "unstable" },
+            self.wall_s,
+            self.steps,
+            pct(self.error)
+        )
+    }
 }
 
 mod nan_as_null {
@@ -209,31 +112,17 @@ mod nan_as_null {
     }
 }
 
-/// One result of the envelope: a row of `results.json` and of the page. The first fields
-/// are those of a run in a case's results file (DESIGN.md); `status` is that of the run that
-/// decided the row (for a bisection, the smallest unstable value's run, `ok` when none).
+/// One result of the envelope: a row of `results.json` and of the page. It starts with the
+/// fields of a run in a case's results file (DESIGN.md), `run`; its `status` is that of the
+/// run that decided the row (for a bisection, the smallest unstable value's run, `ok` when
+/// none), its `metrics` the measured quantities (`dt_multiple_max`, `re_max`, `ke_drift`,
+/// ...; null when none) and its `series` the values tried and whether each was stable.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Row {
-    /// Scheme.
-    pub scheme: String,
-    /// Option set.
-    pub preset: String,
-    /// Spacing \[m\].
-    pub dx: f64,
-    /// Particles.
-    pub particles: usize,
-    /// Steps over all trials.
-    pub steps: usize,
-    /// Wall time over all trials \[s\].
-    pub wall_s: f64,
-    /// `ok` or `diverged: <cause>` of the deciding run.
-    pub status: String,
-    /// Measured quantities (`dt_multiple_max`, `re_max`, `ke_drift`, ...; null when none).
-    #[serde(deserialize_with = "nan_map")]
-    pub metrics: BTreeMap<String, f64>,
-    /// Series: the values tried and whether each was stable (1) or not (0).
-    #[serde(default)]
-    pub series: BTreeMap<String, Vec<f64>>,
+    /// Scheme, option set (`preset`), spacing, particles, steps and wall time over all
+    /// trials, status, metrics, series.
+    #[serde(flatten)]
+    pub run: RunResult,
     /// `dt_max`, `re_max`, `jitter` or `long_run`.
     pub study: String,
     /// `elliptical_drop` or `poiseuille_periodic`.
@@ -246,6 +135,25 @@ pub struct Row {
     pub outcome: String,
     /// Every run of the row.
     pub trials: Vec<Trial>,
+}
+
+impl Checked for Row {
+    fn run(&self) -> &RunResult {
+        &self.run
+    }
+
+    fn study(&self) -> Option<&str> {
+        Some(&self.study)
+    }
+
+    fn case(&self) -> Option<&str> {
+        Some(&self.case)
+    }
+
+    /// None: a row's status names the unstable run that decided it, a result.
+    fn failure(&self) -> Option<String> {
+        None
+    }
 }
 
 /// `reports/stability/results.json`.
@@ -263,7 +171,7 @@ pub struct StabilityResults {
     pub runs: Vec<Row>,
     /// Checks of the envelope.
     pub checks: Vec<CheckResult>,
-    /// False while the study runs (the file is rewritten after every row).
+    /// False while the study runs (the file is rewritten after every batch).
     pub complete: bool,
     /// Wall time of the whole study \[s\].
     pub elapsed_s: f64,
@@ -278,13 +186,12 @@ pub struct StabilityResults {
 impl StabilityResults {
     /// Passed and failed checks.
     pub fn counts(&self) -> (usize, usize) {
-        let passed = self.checks.iter().filter(|c| c.pass).count();
-        (passed, self.checks.len() - passed)
+        check_counts(&self.checks)
     }
 
     /// Whether every check passed.
     pub fn pass(&self) -> bool {
-        self.checks.iter().all(|c| c.pass)
+        check_counts(&self.checks).1 == 0
     }
 }
 
@@ -299,10 +206,12 @@ pub struct StabilityOptions {
     pub workspace: PathBuf,
     /// Tier requested (recorded).
     pub tier: Tier,
-    /// Spacings, ranges and bounds.
-    pub settings: Settings,
+    /// The study's data (`validation/studies/stability.json`, [`Config::load`]).
+    pub config: Config,
     /// Rerun cached runs.
     pub force: bool,
+    /// Runs executed concurrently.
+    pub jobs: usize,
     /// Use the progress display (otherwise one plain line per run on stderr).
     pub progress: bool,
 }
@@ -320,223 +229,264 @@ pub fn split_cases(names: &[String], tier: Tier) -> (Vec<String>, bool, bool) {
     }
 }
 
-/// A case as the study uses it: its template at the study's spacing.
+/// Which base scene, with what it needs for its error and end time.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Kind {
+    /// The elliptical drop: error = larger of the a and b errors over the history.
+    Drop,
+    /// The periodic channel of width D and kinematic viscosity ν (the template's): error =
+    /// the profile L2 error at the end.
+    Channel { width: f64, nu: f64 },
+}
+
+/// A case as the study uses it: its template preset at the study's spacing.
 struct Base {
+    kind: Kind,
     case: Case,
-    /// `drop` or `channel` (slug prefix).
-    short: &'static str,
-    /// The template preset.
-    preset: &'static str,
+    preset: String,
     dx: f64,
     bound: f64,
+    /// End time of the time-step and jitter runs \[s\].
+    end: f64,
 }
 
 impl Base {
-    /// The scene of option set `set` with `edit` applied. For `wcsph`, the drop takes its
-    /// case's `wcsph_tuned` preset and the channel a WCSPH scheme whose sound speed is ten
-    /// times the centre-line speed `F D²/(8ν)` of the (edited) body force, so that a
-    /// Reynolds-number or time-step edit keeps the Mach number at 0.1.
-    fn scene(&self, set: &str, edit: impl FnOnce(&mut Value)) -> Result<Value> {
-        let mut v = crate::sweep::effective_scene(&self.case, self.preset, self.dx)?;
-        let patch = option_patch(set)
-            .ok_or_else(|| HarnessError::case(NAME, format!("unknown option set `{set}`")))?;
-        merge_patch(&mut v, &patch);
-        let wcsph = scheme_of(set) == "wcsph";
-        if wcsph && self.short == "drop" {
-            let preset =
-                self.case.sweep.presets.iter().find(|p| p.name == "wcsph_tuned").ok_or_else(|| {
-                    HarnessError::case(NAME, format!("{} has no wcsph_tuned preset", self.case.case))
+    /// The drop of `config`.
+    fn drop(config: &Config, validation_dir: &Path) -> Result<Base> {
+        let s = &config.settings;
+        let case = Case::load(&validation_dir.join(format!("{}.json", config.drop.case)))?;
+        let preset = config.drop.preset.clone();
+        Ok(Base { kind: Kind::Drop, case, preset, dx: s.drop_dx, bound: s.drop_bound, end: s.drop_end })
+    }
+
+    /// The channel of `config`, to `channel_tau` viscous times D²/ν of its template.
+    fn channel(config: &Config, validation_dir: &Path) -> Result<Base> {
+        let s = &config.settings;
+        let case = Case::load(&validation_dir.join(format!("{}.json", config.channel.case)))?;
+        let ReferenceSpec::PoiseuilleStartup { width, .. } = case.reference else {
+            return Err(HarnessError::case(
+                NAME,
+                format!("{} has no Poiseuille start-up reference", case.case),
+            ));
+        };
+        let nu = case.scene["fluid"]["viscosity"].as_f64().unwrap_or(1e-3)
+            / case.scene["fluid"]["density"].as_f64().unwrap_or(1e3);
+        let end = s.channel_tau * width * width / nu;
+        let preset = config.channel.preset.clone();
+        Ok(Base {
+            kind: Kind::Channel { width, nu },
+            case,
+            preset,
+            dx: s.channel_dx,
+            bound: s.channel_bound,
+            end,
+        })
+    }
+
+    /// The slug prefix (`drop`, `channel`).
+    fn short(&self) -> &'static str {
+        match self.kind {
+            Kind::Drop => "drop",
+            Kind::Channel { .. } => "channel",
+        }
+    }
+
+    /// Ends a scene at the study's end time (the channel's probe times up to there).
+    fn set_end(&self, v: &mut Value) {
+        v["time"]["end"] = json!(self.end);
+        if let Kind::Channel { .. } = self.kind
+            && let Some(times) = v["output"]["probe_times"].as_array_mut()
+        {
+            times.retain(|t| t.as_f64().is_some_and(|t| t < self.end * (1.0 - 1e-9)));
+        }
+    }
+
+    /// The scene of option set `set` with `edit` applied: the template preset at the
+    /// study's spacing, the set's patch, its case preset and patch for this case, `edit`,
+    /// then the sound speed it asks for (from the edited body force).
+    fn scene(&self, set: &OptionSet, edit: impl FnOnce(&mut Value)) -> Result<Value> {
+        let mut v = effective_scene(&self.case, &self.preset, self.dx)?;
+        merge_patch(&mut v, &set.patch);
+        let own = set.cases.get(&self.case.case);
+        if let Some(o) = own {
+            if let Some(name) = &o.preset {
+                let preset = self.case.sweep.presets.iter().find(|p| &p.name == name).ok_or_else(|| {
+                    HarnessError::case(
+                        NAME,
+                        format!("option set `{}`: {} has no preset `{name}`", set.name, self.case.case),
+                    )
                 })?;
-            merge_patch(&mut v, &preset.patch);
+                merge_patch(&mut v, &preset.patch);
+            }
+            merge_patch(&mut v, &o.patch);
         }
         edit(&mut v);
-        if wcsph && self.short == "channel" {
-            let width = match self.case.reference {
-                crate::case::ReferenceSpec::PoiseuilleStartup { width, .. } => width,
-                _ => return Err(HarnessError::case(NAME, "the channel has no start-up reference")),
+        if let Some(multiple) = own.and_then(|o| o.sound_speed_over_u_max) {
+            let Kind::Channel { width, .. } = self.kind else {
+                return Err(HarnessError::case(
+                    NAME,
+                    format!("option set `{}`: a sound speed from u_max needs the channel", set.name),
+                ));
             };
             let force = v["body_force"][0].as_f64().unwrap_or(0.0).abs();
             let nu = v["fluid"]["viscosity"].as_f64().unwrap_or(1e-3)
                 / v["fluid"]["density"].as_f64().unwrap_or(1e3);
             let u_max = force * width * width / (8.0 * nu);
-            v["scheme"] = json!({"wcsph": {"sound_speed": 10.0 * u_max,
-                "artificial_viscosity": {"alpha": 0.0, "beta": 0.0}, "density_diffusion": 0.1}});
-        }
-        if set == WCSPH_XU {
-            v["scheme"]["wcsph"]["shifting"] = json!({"xu": {"coefficient": 0.02}});
+            v["scheme"]["wcsph"]["sound_speed"] = json!(multiple * u_max);
         }
         Ok(v)
     }
+
+    /// The job of run `slug`: option set `set` with `edit`.
+    fn job(&self, set: &OptionSet, slug: String, edit: impl FnOnce(&mut Value)) -> Result<Job> {
+        let scene = self.scene(set, edit)?;
+        Ok(Job::new(RunSpec::from_json(NAME, slug, &set.name, self.dx, &scene)?))
+    }
+
+    /// Measures the run `slug` that tried `value` against this case's reference.
+    fn measure(&self, value: f64, slug: &str, ran: Ran) -> Result<Measured> {
+        let record = match ran {
+            Ran::Finished { record, .. } => record,
+            Ran::Panicked { message } => {
+                let trial = Trial {
+                    value,
+                    slug: slug.to_string(),
+                    status: format!("panic: {message}"),
+                    steps: 0,
+                    t_final: 0.0,
+                    wall_s: 0.0,
+                    error: f64::NAN,
+                    stable: false,
+                };
+                return Ok(Measured { trial, particles: 0, t: Vec::new(), energy: Vec::new() });
+            }
+        };
+        let probes = meniscus::ProbeRecord::from(record.probes.clone());
+        let measured =
+            crate::metrics::compute(&self.case.reference, &record.scene, &probes, record.summary.particles)
+                .map_err(|source| HarnessError::Reference { case: NAME.into(), source })?;
+        let error = match self.kind {
+            Kind::Drop => {
+                let a = measured.metrics.get("a_rel_err_max").copied().unwrap_or(f64::NAN);
+                let b = measured.metrics.get("b_rel_err_max").copied().unwrap_or(f64::NAN);
+                if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) }
+            }
+            Kind::Channel { .. } => {
+                measured.series.get("u_profile_l2_rel").and_then(|s| s.last().copied()).unwrap_or(f64::NAN)
+            }
+        };
+        let status = record.status();
+        let s = &record.summary;
+        let trial = Trial {
+            value,
+            slug: slug.to_string(),
+            stable: status == "ok" && error <= self.bound,
+            status,
+            steps: s.steps,
+            t_final: s.t_end,
+            wall_s: s.wall_s,
+            error,
+        };
+        let energy =
+            record.probes.series.get("kinetic_energy").and_then(|q| q.get("e")).cloned().unwrap_or_default();
+        Ok(Measured { trial, particles: s.particles, t: record.probes.t, energy })
+    }
 }
 
-/// A trial with what the rows need besides it.
+/// A trial with what the rows need besides it: particles, and the kinetic energy history
+/// (`t`, `e`) for the long run.
 struct Measured {
     trial: Trial,
     particles: usize,
-    probes: CachedProbes,
+    t: Vec<f64>,
+    energy: Vec<f64>,
+}
+
+/// One bisection of an option set on a base: its scene per value and the trials so far.
+struct Search<'a> {
+    base: &'a Base,
+    /// `dt_max` or `re_max`.
+    study: &'static str,
+    /// `k` or `Re`.
+    symbol: &'static str,
+    config: String,
+    bisection: Bisection,
+    /// The job that tries a value.
+    job: Box<dyn Fn(f64) -> Result<Job> + 'a>,
+    trials: Vec<Trial>,
+    particles: usize,
+}
+
+impl<'a> Search<'a> {
+    /// The bisection of `study` (of the quantity `symbol`) over `range` in `iterations`
+    /// steps on `base`, described by `config`; `job` tries a value.
+    fn new(
+        base: &'a Base,
+        (study, symbol): (&'static str, &'static str),
+        config: String,
+        (range, iterations): ([f64; 2], usize),
+        job: impl Fn(f64) -> Result<Job> + 'a,
+    ) -> Self {
+        let bisection = Bisection::new(range[0], range[1], iterations);
+        Search {
+            base,
+            study,
+            symbol,
+            config,
+            bisection,
+            job: Box::new(job),
+            trials: Vec::new(),
+            particles: 0,
+        }
+    }
+
+    /// The bisection's row.
+    fn row(self, set: &OptionSet) -> Row {
+        let bracket = self.bisection.bracket().expect("the bisection is done");
+        bisection_row(
+            self.base,
+            set,
+            self.study,
+            self.config,
+            self.symbol,
+            bracket,
+            self.trials,
+            self.particles,
+        )
+    }
+}
+
+/// Runs `searches` together until every bisection is done: each step tries the next value
+/// of every unfinished one, as one batch of the runner.
+fn bisect_together(runner: &Runner, dir: &Path, searches: &mut [Search]) -> Result<()> {
+    loop {
+        let tried: Vec<(usize, f64)> = searches
+            .iter()
+            .enumerate()
+            .filter_map(|(i, s)| s.bisection.next_value().map(|v| (i, v)))
+            .collect();
+        if tried.is_empty() {
+            return Ok(());
+        }
+        let jobs = tried.iter().map(|&(i, value)| (searches[i].job)(value)).collect::<Result<Vec<_>>>()?;
+        let bases: Vec<&Base> = tried.iter().map(|&(i, _)| searches[i].base).collect();
+        let measured = runner.run(dir, None, &jobs, |k, ran| {
+            let m = bases[k].measure(tried[k].1, &jobs[k].spec.slug, ran)?;
+            let line = m.trial.line();
+            Ok((m, line))
+        })?;
+        for (&(i, _), m) in tried.iter().zip(measured) {
+            let s = &mut searches[i];
+            s.bisection.record(m.trial.stable);
+            s.particles = s.particles.max(m.particles);
+            s.trials.push(m.trial);
+        }
+    }
 }
 
 /// Whether two parameter values are the same point of a bisection.
 fn same(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-12 * a.abs().max(b.abs())
-}
-
-/// The runner: runs (or reuses) trials and measures them.
-struct Runner<'a> {
-    opts: &'a StabilityOptions,
-    dir: PathBuf,
-    progress: Progress,
-    executed: usize,
-    reused: usize,
-    panics: usize,
-}
-
-impl Runner<'_> {
-    /// Bisects `[lo, hi]` over `iterations` trials of `base`: `scene(value)` gives the run's
-    /// slug and scene. Returns the bracket, the trials and the largest particle count; the
-    /// first error stops the bisection and is returned.
-    fn bisect_trials(
-        &mut self,
-        base: &Base,
-        (lo, hi, iterations): (f64, f64, usize),
-        mut scene: impl FnMut(f64) -> (String, Result<Value>),
-    ) -> Result<(Bracket, Vec<Trial>, usize)> {
-        let mut trials = Vec::new();
-        let mut particles = 0;
-        let mut failure = None;
-        let bracket = bisect(lo, hi, iterations, |value| {
-            if failure.is_some() {
-                return false;
-            }
-            let (slug, sc) = scene(value);
-            match sc.and_then(|sc| self.trial(base, slug, value, sc)) {
-                Ok(m) => {
-                    particles = particles.max(m.particles);
-                    let stable = m.trial.stable;
-                    trials.push(m.trial);
-                    stable
-                }
-                Err(e) => {
-                    failure = Some(e);
-                    false
-                }
-            }
-        });
-        match failure {
-            Some(e) => Err(e),
-            None => Ok((bracket, trials, particles)),
-        }
-    }
-
-    /// Runs `scene` (cached by scene hash) and measures it against `base`'s reference.
-    fn trial(&mut self, base: &Base, slug: String, value: f64, scene: Value) -> Result<Measured> {
-        let parsed = meniscus::Scene::from_json(&scene.to_string())
-            .map_err(|source| HarnessError::Scene { case: NAME.into(), run: slug.clone(), source })?;
-        let canonical = serde_json::to_value(&parsed)
-            .map_err(|e| HarnessError::case(NAME, format!("run {slug}: scene does not serialise: {e}")))?;
-        let hash = sha256_hex(&format!("{}\n{canonical}", crate::sweep::build_fingerprint()));
-        let path = cache::record_path(&self.dir, &slug);
-        let cached = if self.opts.force { None } else { cache::load(&path, &hash) };
-        let record = match cached {
-            Some(r) => {
-                self.reused += 1;
-                Some(r)
-            }
-            None => {
-                self.executed += 1;
-                let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-                    meniscus::run(&parsed, &mut meniscus::Quiet)
-                }));
-                match run {
-                    Ok(report) => {
-                        let report = report.map_err(|source| HarnessError::Scene {
-                            case: NAME.into(),
-                            run: slug.clone(),
-                            source,
-                        })?;
-                        let record = RunRecord {
-                            completed: true,
-                            slug: slug.clone(),
-                            scheme: if scene["scheme"].get("wcsph").is_some() { "wcsph" } else { "isph" }
-                                .into(),
-                            preset: String::new(),
-                            dx: base.dx,
-                            scene_hash: hash,
-                            scene: canonical.clone(),
-                            summary: report.summary,
-                            probes: CachedProbes::from(report.probes),
-                            snapshots: Vec::new(),
-                        };
-                        cache::store(&path, &record)?;
-                        Some(record)
-                    }
-                    Err(panic) => {
-                        self.panics += 1;
-                        let msg = panic
-                            .downcast_ref::<String>()
-                            .cloned()
-                            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-                            .unwrap_or_else(|| "unknown panic".into());
-                        let trial = Trial {
-                            value,
-                            slug,
-                            status: format!("panic: {msg}"),
-                            steps: 0,
-                            t_final: 0.0,
-                            wall_s: 0.0,
-                            error: f64::NAN,
-                            stable: false,
-                        };
-                        self.print(&trial);
-                        return Ok(Measured { trial, particles: 0, probes: CachedProbes::default() });
-                    }
-                }
-            }
-        };
-        let r = record.expect("a record unless the run panicked");
-        let probes = meniscus::ProbeRecord::from(r.probes.clone());
-        let measured =
-            crate::metrics::compute(&base.case.reference, &canonical, &probes, r.summary.particles)
-                .map_err(|source| HarnessError::Reference { case: NAME.into(), source })?;
-        let error = match base.short {
-            "drop" => {
-                let a = measured.metrics.get("a_rel_err_max").copied().unwrap_or(f64::NAN);
-                let b = measured.metrics.get("b_rel_err_max").copied().unwrap_or(f64::NAN);
-                if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) }
-            }
-            _ => measured.series.get("u_profile_l2_rel").and_then(|s| s.last().copied()).unwrap_or(f64::NAN),
-        };
-        let ok = r.summary.status == meniscus::Status::Ok && r.summary.error.is_none();
-        let status = if ok {
-            "ok".to_string()
-        } else {
-            format!("diverged: {}", r.summary.error.as_deref().unwrap_or("unknown cause"))
-        };
-        let trial = Trial {
-            value,
-            slug,
-            status,
-            steps: r.summary.steps,
-            t_final: r.summary.t_end,
-            wall_s: r.summary.wall_s,
-            error,
-            stable: ok && error <= base.bound,
-        };
-        self.print(&trial);
-        Ok(Measured { trial, particles: r.summary.particles, probes: r.probes })
-    }
-
-    /// One line per run (plainly on stderr when the display is hidden, as the cases do).
-    fn print(&self, t: &Trial) {
-        self.progress.println(&format!(
-            "  {} {} ({:.1} s, {} steps, error {})",
-            t.slug,
-            if t.stable { "stable" } else { "unstable" },
-            t.wall_s,
-            t.steps,
-            pct(t.error)
-        ));
-    }
 }
 
 /// A parameter value in a slug: up to 4 decimals, trailing zeros dropped.
@@ -545,11 +495,26 @@ fn slug_value(v: f64) -> String {
     s.trim_end_matches('0').trim_end_matches('.').to_string()
 }
 
+/// A row's run fields for option set `set` on `base`.
+fn row_run(base: &Base, set: &OptionSet, trials: &[Trial], particles: usize) -> RunResult {
+    RunResult {
+        scheme: set.scheme.clone(),
+        preset: set.name.clone(),
+        dx: base.dx,
+        particles,
+        steps: trials.iter().map(|t| t.steps).sum(),
+        wall_s: trials.iter().map(|t| t.wall_s).sum(),
+        status: "ok".into(),
+        metrics: BTreeMap::new(),
+        series: BTreeMap::new(),
+    }
+}
+
 /// Assembles a bisection row from its trials.
 #[allow(clippy::too_many_arguments)]
 fn bisection_row(
     base: &Base,
-    set: &str,
+    set: &OptionSet,
     study: &str,
     config: String,
     symbol: &str,
@@ -557,7 +522,7 @@ fn bisection_row(
     trials: Vec<Trial>,
     particles: usize,
 ) -> Row {
-    let mut metrics = BTreeMap::new();
+    let mut run = row_run(base, set, &trials, particles);
     let at_stable = bracket.stable().and_then(|s| trials.iter().find(|t| same(t.value, s)));
     let unstable_value = match bracket {
         Bracket::Found { unstable, .. } => Some(unstable),
@@ -566,62 +531,53 @@ fn bisection_row(
     };
     let deciding = unstable_value.and_then(|u| trials.iter().find(|t| same(t.value, u)));
     let key = if study == "dt_max" { "dt_multiple" } else { "re" };
-    metrics.insert(format!("{key}_max"), bracket.stable().unwrap_or(f64::NAN));
-    metrics.insert(format!("{key}_unstable"), unstable_value.unwrap_or(f64::NAN));
-    metrics.insert("err_at_max".into(), at_stable.map_or(f64::NAN, |t| t.error));
+    run.metrics.insert(format!("{key}_max"), bracket.stable().unwrap_or(f64::NAN));
+    run.metrics.insert(format!("{key}_unstable"), unstable_value.unwrap_or(f64::NAN));
+    run.metrics.insert("err_at_max".into(), at_stable.map_or(f64::NAN, |t| t.error));
     if study == "dt_max" {
         let mean_dt = at_stable.map_or(f64::NAN, |t| t.t_final / t.steps.max(1) as f64);
-        metrics.insert("dt_mean_s_at_max".into(), mean_dt);
+        run.metrics.insert("dt_mean_s_at_max".into(), mean_dt);
     }
     let mut sorted: Vec<&Trial> = trials.iter().collect();
     sorted.sort_by(|a, b| a.value.total_cmp(&b.value));
-    let series = BTreeMap::from([
+    run.series = BTreeMap::from([
         ("value".to_string(), sorted.iter().map(|t| t.value).collect()),
         ("stable".to_string(), sorted.iter().map(|t| if t.stable { 1.0 } else { 0.0 }).collect()),
     ]);
+    if let Some(t) = deciding {
+        run.status = t.status.clone();
+    }
     Row {
-        scheme: scheme_of(set).into(),
-        preset: set.into(),
-        dx: base.dx,
-        particles,
-        steps: trials.iter().map(|t| t.steps).sum(),
-        wall_s: trials.iter().map(|t| t.wall_s).sum(),
-        status: deciding.map_or("ok".into(), |t| t.status.clone()),
-        metrics,
-        series,
+        run,
         study: study.into(),
         case: base.case.case.clone(),
         config,
         measured: format!("{symbol} {}", bracket.describe()),
         outcome: deciding
-            .map(|t| {
-                format!(
-                    "at {symbol} = {}: {}",
-                    bisect::sig3(t.value),
-                    t.reason(base.bound).unwrap_or_default()
-                )
-            })
+            .map(|t| format!("at {symbol} = {}: {}", sig3(t.value), t.reason(base.bound).unwrap_or_default()))
             .unwrap_or_else(|| "ok".into()),
         trials,
     }
 }
 
 /// A one-run row (jitter, long run).
-fn single_row(base: &Base, set: &str, study: &str, config: String, trial: Trial, particles: usize) -> Row {
+fn single_row(
+    base: &Base,
+    set: &OptionSet,
+    study: &str,
+    config: String,
+    trial: Trial,
+    particles: usize,
+) -> Row {
+    let mut run = row_run(base, set, std::slice::from_ref(&trial), particles);
+    run.status = if trial.status.starts_with("panic") {
+        format!("diverged: {}", trial.status)
+    } else {
+        trial.status.clone()
+    };
+    run.metrics = BTreeMap::from([("err".to_string(), trial.error), ("t_final".to_string(), trial.t_final)]);
     Row {
-        scheme: scheme_of(set).into(),
-        preset: set.into(),
-        dx: base.dx,
-        particles,
-        steps: trial.steps,
-        wall_s: trial.wall_s,
-        status: if trial.status.starts_with("panic") {
-            format!("diverged: {}", trial.status)
-        } else {
-            trial.status.clone()
-        },
-        metrics: BTreeMap::from([("err".to_string(), trial.error), ("t_final".to_string(), trial.t_final)]),
-        series: BTreeMap::new(),
+        run,
         study: study.into(),
         case: base.case.case.clone(),
         config,
@@ -634,39 +590,19 @@ fn single_row(base: &Base, set: &str, study: &str, config: String, trial: Trial,
 /// Runs the stability envelope into `<out>/stability/` and refreshes `<out>/index.html`.
 pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
     let start = Instant::now();
-    let s = &opts.settings;
-    for set in &s.option_sets {
-        if option_patch(set).is_none() {
-            return Err(HarnessError::case(NAME, format!("unknown option set `{set}`")));
-        }
-    }
-    let drop = Base {
-        case: Case::load(&opts.validation_dir.join("elliptical_drop.json"))?,
-        short: "drop",
-        preset: "paper",
-        dx: s.drop_dx,
-        bound: s.drop_bound,
-    };
-    let channel = Base {
-        case: Case::load(&opts.validation_dir.join("poiseuille_periodic.json"))?,
-        short: "channel",
-        preset: "re40",
-        dx: s.channel_dx,
-        bound: s.channel_bound,
-    };
+    let cfg = &opts.config;
+    let s = &cfg.settings;
+    let sets: Vec<&OptionSet> =
+        s.option_sets.iter().map(|name| cfg.option_set(name)).collect::<Result<_>>()?;
+    let drop = Base::drop(cfg, &opts.validation_dir)?;
+    let channel = Base::channel(cfg, &opts.validation_dir)?;
+    let Kind::Channel { width, nu } = channel.kind else { unreachable!("the channel's kind") };
     let dir = opts.out.join(NAME);
-    let mut runner = Runner {
-        opts,
-        dir: dir.clone(),
-        progress: Progress::new(opts.progress),
-        executed: 0,
-        reused: 0,
-        panics: 0,
-    };
+    let runner = Runner::new(Progress::new(opts.progress), opts.force, opts.jobs);
     let mut results = StabilityResults {
         case: NAME.into(),
         scheme: {
-            let mut schemes: Vec<&str> = s.option_sets.iter().map(|o| scheme_of(o)).collect();
+            let mut schemes: Vec<&str> = sets.iter().map(|o| o.scheme.as_str()).collect();
             schemes.dedup();
             schemes.join(", ")
         },
@@ -680,148 +616,138 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
         reused: 0,
         provenance: Provenance::collect(&opts.workspace),
     };
-    let nu_of = |v: &Value| {
-        v["fluid"]["viscosity"].as_f64().unwrap_or(1e-3) / v["fluid"]["density"].as_f64().unwrap_or(1e3)
-    };
-    // The channel's width and viscous time, from its reference and template.
-    let width = match channel.case.reference {
-        crate::case::ReferenceSpec::PoiseuilleStartup { width, .. } => width,
-        _ => return Err(HarnessError::case(NAME, "poiseuille_periodic has no start-up reference")),
-    };
-    let nu = nu_of(&channel.case.scene);
-    let channel_end = s.channel_tau * width * width / nu;
-    // Channel runs end at channel_tau D²/ν, with the probe times up to there.
-    let channel_time = |v: &mut Value| {
-        v["time"]["end"] = json!(channel_end);
-        if let Some(times) = v["output"]["probe_times"].as_array_mut() {
-            times.retain(|t| t.as_f64().is_some_and(|t| t < channel_end * (1.0 - 1e-9)));
-        }
-    };
-    let drop_end = s.drop_end;
-    let drop_time = |v: &mut Value| v["time"]["end"] = json!(drop_end);
-    let save = |results: &mut StabilityResults, runner: &Runner, start: &Instant| -> Result<()> {
+    let save = |results: &mut StabilityResults| -> Result<()> {
         results.elapsed_s = start.elapsed().as_secs_f64();
-        results.executed = runner.executed;
-        results.reused = runner.reused;
+        (results.executed, results.reused) = (runner.tally().executed, runner.tally().reused);
         io::write_json(&dir.join("results.json"), results)
     };
 
-    for set in &s.option_sets {
-        // Largest stable multiple of the adaptive step.
-        for (base, time) in [(&drop, &drop_time as &dyn Fn(&mut Value)), (&channel, &channel_time)] {
+    for set in sets.iter().copied() {
+        // Largest stable multiple of the adaptive step (drop and channel) and, for ISPH,
+        // largest stable Reynolds number of the channel. WCSPH's acoustic step (c0 ∝ Re)
+        // needs about 1e3 Re steps to 1 D²/ν (measured: 39 064 at Re = 40), four million at
+        // the range's Re = 4000.
+        let mut searches = Vec::new();
+        for base in [&drop, &channel] {
             let template_max =
-                crate::sweep::effective_scene(&base.case, base.preset, base.dx)?["time"]["step"]["adaptive"]
-                    ["max"]
+                effective_scene(&base.case, &base.preset, base.dx)?["time"]["step"]["adaptive"]["max"]
                     .as_f64()
                     .unwrap_or(1e-3);
-            let (bracket, trials, particles) =
-                runner.bisect_trials(base, (s.dt_range[0], s.dt_range[1], s.dt_iterations), |k| {
-                    let scene = base.scene(set, |v| {
-                        time(v);
-                        v["time"]["step"] = json!({"adaptive": {"cfl": 0.2 * k, "viscous": 0.2 * k, "max": template_max * k}});
-                    });
-                    (format!("{}-{set}-dt_k{}", base.short, slug_value(k)), scene)
-                })?;
             let config = format!(
                 "{}, dx = {}, to t = {} s; Δt = k × adaptive step (α_c = α_d = 0.2 k), k bisected in [{}, {}]",
                 base.case.case,
-                crate::report::html::format_dx(base.dx),
-                bisect::sig3(if base.short == "drop" { drop_end } else { channel_end }),
+                format_dx(base.dx),
+                sig3(base.end),
                 s.dt_range[0],
                 s.dt_range[1]
             );
-            results.runs.push(bisection_row(base, set, "dt_max", config, "k", bracket, trials, particles));
-            save(&mut results, &runner, &start)?;
+            searches.push(Search::new(base, ("dt_max", "k"), config, (s.dt_range, s.dt_iterations), move |k| {
+                let slug = format!("{}-{}-dt_k{}", base.short(), set.name, slug_value(k));
+                base.job(set, slug, |v| {
+                    base.set_end(v);
+                    v["time"]["step"] =
+                        json!({"adaptive": {"cfl": ALPHA * k, "viscous": ALPHA * k, "max": template_max * k}});
+                })
+            }));
         }
-        // Largest stable Reynolds number of the channel: ISPH only. WCSPH's acoustic step
-        // (c0 ∝ Re) needs about 1e3 Re steps to 1 D²/ν (measured: 39 064 at Re = 40), four
-        // million at the range's Re = 4000.
-        if scheme_of(set) == "isph" {
-            let (bracket, trials, particles) =
-                runner.bisect_trials(&channel, (s.re_range[0], s.re_range[1], s.re_iterations), |re| {
-                    let force = 12.0 * nu * nu * re / width.powi(3);
-                    let scene = channel.scene(set, |v| {
-                        channel_time(v);
-                        v["body_force"] = json!([force, 0.0]);
-                    });
-                    (format!("channel-{set}-re{}", slug_value(re)), scene)
-                })?;
+        if set.scheme == "isph" {
             let config = format!(
-                "poiseuille_periodic, dx = {}, to {} D²/ν; F = 12 ν² Re / D³ (ν = {nu:e} m²/s), adaptive step (α = 0.2), Re bisected in [{}, {}]",
-                crate::report::html::format_dx(channel.dx),
+                "{}, dx = {}, to {} D²/ν; F = 12 ν² Re / D³ (ν = {nu:e} m²/s), adaptive step (α = 0.2), Re bisected in [{}, {}]",
+                channel.case.case,
+                format_dx(channel.dx),
                 s.channel_tau,
                 s.re_range[0],
                 s.re_range[1]
             );
-            results
-                .runs
-                .push(bisection_row(&channel, set, "re_max", config, "Re", bracket, trials, particles));
-            save(&mut results, &runner, &start)?;
+            let base = &channel;
+            searches.push(Search::new(
+                base,
+                ("re_max", "Re"),
+                config,
+                (s.re_range, s.re_iterations),
+                move |re| {
+                    let force = 12.0 * nu * nu * re / width.powi(3);
+                    base.job(set, format!("channel-{}-re{}", set.name, slug_value(re)), |v| {
+                        base.set_end(v);
+                        v["body_force"] = json!([force, 0.0]);
+                    })
+                },
+            ));
         }
-        // Jittered initial lattices.
-        for (base, time) in [(&drop, &drop_time as &dyn Fn(&mut Value)), (&channel, &channel_time)] {
+        bisect_together(&runner, &dir, &mut searches)?;
+        results.runs.extend(searches.into_iter().map(|search| search.row(set)));
+        save(&mut results)?;
+
+        // Jittered initial lattices of both cases, and the drop's long run (kinetic-energy
+        // drift), as one batch.
+        let mut jobs = Vec::new();
+        let mut tried = Vec::new();
+        for base in [&drop, &channel] {
             for &f in &s.jitter {
-                let scene = base.scene(set, |v| {
-                    time(v);
+                let slug = format!("{}-{}-jitter{}", base.short(), set.name, slug_value(f));
+                jobs.push(base.job(set, slug, |v| {
+                    base.set_end(v);
                     v["bodies"][0]["jitter"] = json!({"fraction": f, "seed": s.seed});
-                })?;
-                let slug = format!("{}-{set}-jitter{}", base.short, slug_value(f));
-                let Measured { trial, particles, .. } = runner.trial(base, slug, f, scene)?;
-                let config = format!(
-                    "{}, dx = {}, lattice jittered by {} % of dx (seed {}), the case's time step",
-                    base.case.case,
-                    crate::report::html::format_dx(base.dx),
-                    bisect::sig3(100.0 * f),
-                    s.seed
-                );
-                let mut row = single_row(base, set, "jitter", config, trial, particles);
-                row.metrics.insert("jitter_fraction".into(), f);
-                row.measured = if row.status == "ok" {
-                    format!("error {}", pct(row.metrics["err"]))
-                } else {
-                    format!("diverged at t = {} s", bisect::sig3(row.metrics["t_final"]))
-                };
-                results.runs.push(row);
+                })?);
+                tried.push((base, f));
             }
-            save(&mut results, &runner, &start)?;
         }
-        // The drop's long run: kinetic-energy drift.
-        {
-            let long_end = s.long_end;
-            let scene = drop.scene(set, |v| v["time"]["end"] = json!(long_end))?;
-            let slug = format!("drop-{set}-long{}", slug_value(long_end));
-            let Measured { trial, particles, probes } = runner.trial(&drop, slug, long_end, scene)?;
-            let e = probes.series.get("kinetic_energy").and_then(|q| q.get("e")).cloned().unwrap_or_default();
-            let drift = crate::metrics::drift(&e);
-            let (e_series, t_series) = (e, probes.t);
+        let long_slug = format!("drop-{}-long{}", set.name, slug_value(s.long_end));
+        jobs.push(drop.job(set, long_slug, |v| v["time"]["end"] = json!(s.long_end))?);
+        tried.push((&drop, s.long_end));
+        let mut measured = runner.run(&dir, None, &jobs, |k, ran| {
+            let m = tried[k].0.measure(tried[k].1, &jobs[k].spec.slug, ran)?;
+            let line = m.trial.line();
+            Ok((m, line))
+        })?;
+        let long = measured.pop().expect("the long run was in the batch");
+        for ((base, f), Measured { trial, particles, .. }) in tried.into_iter().zip(measured) {
             let config = format!(
-                "elliptical_drop, dx = {}, to t = {} s (the case ends at 0.008 s), the case's time step",
-                crate::report::html::format_dx(drop.dx),
-                bisect::sig3(long_end)
+                "{}, dx = {}, lattice jittered by {} % of dx (seed {}), the case's time step",
+                base.case.case,
+                format_dx(base.dx),
+                sig3(100.0 * f),
+                s.seed
             );
-            let mut row = single_row(&drop, set, "long_run", config, trial, particles);
-            // The long run's verdict is the energy drift, not the axes' error.
-            row.outcome = if row.status == "ok" { "ok".into() } else { row.status.clone() };
-            row.metrics.insert("ke_drift".into(), drift);
-            row.measured = if row.status == "ok" {
-                format!("KE drift {}", pct(drift))
+            let mut row = single_row(base, set, "jitter", config, trial, particles);
+            row.run.metrics.insert("jitter_fraction".into(), f);
+            row.measured = if row.run.status == "ok" {
+                format!("error {}", pct(row.run.metrics["err"]))
             } else {
-                let t = row.trials.first().map_or(f64::NAN, |t| t.t_final);
-                format!("diverged at t = {} s (KE drift {} up to there)", bisect::sig3(t), pct(drift))
+                format!("diverged at t = {} s", sig3(row.run.metrics["t_final"]))
             };
-            row.series = BTreeMap::from([("t".to_string(), t_series), ("e".to_string(), e_series)]);
             results.runs.push(row);
-            save(&mut results, &runner, &start)?;
         }
+        let drift = crate::metrics::drift(&long.energy);
+        let config = format!(
+            "{}, dx = {}, to t = {} s (the case ends at {} s), the case's time step",
+            drop.case.case,
+            format_dx(drop.dx),
+            sig3(s.long_end),
+            sig3(drop.case.scene["time"]["end"].as_f64().unwrap_or(f64::NAN))
+        );
+        let mut row = single_row(&drop, set, "long_run", config, long.trial, long.particles);
+        // The long run's verdict is the energy drift, not the axes' error.
+        row.outcome = if row.run.status == "ok" { "ok".into() } else { row.run.status.clone() };
+        row.run.metrics.insert("ke_drift".into(), drift);
+        row.measured = if row.run.status == "ok" {
+            format!("KE drift {}", pct(drift))
+        } else {
+            let t = row.trials.first().map_or(f64::NAN, |t| t.t_final);
+            format!("diverged at t = {} s (KE drift {} up to there)", sig3(t), pct(drift))
+        };
+        row.run.series = BTreeMap::from([("t".to_string(), long.t), ("e".to_string(), long.energy)]);
+        results.runs.push(row);
+        save(&mut results)?;
     }
-    results.checks = checks(&results, runner.panics);
+    results.checks = checks(&cfg.checks, &results.runs, runner.tally().panicked, opts.tier);
     results.complete = true;
-    save(&mut results, &runner, &start)?;
-    let page = page::render(&results);
-    io::write_atomic(&dir.join("index.html"), page.as_bytes())?;
+    save(&mut results)?;
+    io::write_atomic(&dir.join("index.html"), page::render(&results, cfg).as_bytes())?;
     // The index links the study.
-    let known = crate::validate::known_cases(&opts.validation_dir)?;
-    crate::report::render(&opts.out, &crate::report::RenderOptions { cases: Some(known), baseline: None })?;
+    let cases = Some(crate::case::known_cases(&opts.validation_dir)?);
+    let extras = vec![results.index_entry()];
+    crate::report::render(&opts.out, &crate::report::RenderOptions { cases, baseline: None, extras })?;
     Ok(results)
 }
 
@@ -830,105 +756,56 @@ pub(crate) fn pct(v: f64) -> String {
     if v.is_finite() { format!("{:.3} %", 100.0 * v) } else { "—".into() }
 }
 
-/// The envelope's checks, stated before the numbers were known (issue #6): no panic and
-/// every run explained; Qiu's α = 0.2 step stable for the drop and the channel; the channel
-/// stable at Re = 400 to 1 D²/ν; the drop's energy drift to 0.02 s within 2 %; the paper's
-/// option set within its error bound with a 10 % jitter. The time-step and energy checks
-/// are repeated for WCSPH (added with its option set).
-pub fn checks(results: &StabilityResults, panics: usize) -> Vec<CheckResult> {
-    let row = |study: &str, case: &str, set: &str| {
-        results.runs.iter().find(|r| r.study == study && r.case == case && r.preset == set)
-    };
-    let metric =
-        |r: Option<&Row>, m: &str| r.and_then(|r| r.metrics.get(m).copied()).filter(|v| v.is_finite());
-    let min = |name: &str, value: Option<f64>, threshold: f64, missing: &str| CheckResult {
+/// The envelope's checks (the study file's, in order) on its `rows`; `panics` counts the
+/// runs whose solver panicked. A [`Check::Bound`] of another tier is left out.
+pub fn checks(specs: &[Check], rows: &[Row], panics: usize, tier: Tier) -> Vec<CheckResult> {
+    let result = |name: &str, value: Option<f64>, pass: bool, note: Option<&str>| CheckResult {
         name: name.into(),
         value,
-        threshold: Some(threshold),
-        pass: value.is_some_and(|v| v >= threshold),
-        note: value.is_none().then(|| missing.to_string()),
-    };
-    let max = |name: &str, value: Option<f64>, threshold: f64, missing: &str| CheckResult {
-        name: name.into(),
-        value,
-        threshold: Some(threshold),
-        pass: value.is_some_and(|v| v <= threshold),
-        note: value.is_none().then(|| missing.to_string()),
-    };
-    let unexplained = results
-        .runs
-        .iter()
-        .flat_map(|r| &r.trials)
-        .filter(|t| !(t.status == "ok" || t.status.starts_with("diverged: ")))
-        .count();
-    let mut out = vec![max(
-        "every stress run ends at its end time or with a typed, explained error (count of panics and others)",
-        Some((panics + unexplained) as f64),
-        0.0,
-        "",
-    )];
-    let none = "not run (no result, or unstable over the whole range)";
-    out.push(min(
-        "drop (xu): largest stable multiple of the adaptive step ≥ 1 (Qiu's α = 0.2)",
-        metric(row("dt_max", "elliptical_drop", "xu"), "dt_multiple_max"),
-        1.0,
-        none,
-    ));
-    out.push(min(
-        "channel (xu): largest stable multiple of the adaptive step ≥ 1 (Qiu's α = 0.2)",
-        metric(row("dt_max", "poiseuille_periodic", "xu"), "dt_multiple_max"),
-        1.0,
-        none,
-    ));
-    out.push(min(
-        "channel (xu): stable at Re = 400 to the end time",
-        metric(row("re_max", "poiseuille_periodic", "xu"), "re_max"),
-        400.0,
-        none,
-    ));
-    out.push(max(
-        "drop (xu): kinetic-energy drift of the long run ≤ 2 %",
-        metric(row("long_run", "elliptical_drop", "xu"), "ke_drift"),
-        0.02,
-        "not run or not measurable (diverged before the first sample)",
-    ));
-    // The same bounds for WCSPH, without and with shifting (no Reynolds-number study: see
-    // `run`).
-    for set in [WCSPH, WCSPH_XU] {
-        out.push(min(
-            &format!("drop ({set}): largest stable multiple of the adaptive step ≥ 1"),
-            metric(row("dt_max", "elliptical_drop", set), "dt_multiple_max"),
-            1.0,
-            none,
-        ));
-        out.push(min(
-            &format!("channel ({set}): largest stable multiple of the adaptive step ≥ 1"),
-            metric(row("dt_max", "poiseuille_periodic", set), "dt_multiple_max"),
-            1.0,
-            none,
-        ));
-        out.push(max(
-            &format!("drop ({set}): kinetic-energy drift of the long run ≤ 2 %"),
-            metric(row("long_run", "elliptical_drop", set), "ke_drift"),
-            0.02,
-            "not run or not measurable (diverged before the first sample)",
-        ));
-    }
-    let jittered: Vec<&Row> = results
-        .runs
-        .iter()
-        .filter(|r| r.study == "jitter" && r.preset == "xu")
-        .filter(|r| r.metrics.get("jitter_fraction").is_some_and(|f| (f - 0.1).abs() < 1e-12))
-        .collect();
-    let failing = jittered.iter().filter(|r| !r.trials.iter().all(|t| t.stable)).count();
-    out.push(CheckResult {
-        name: "xu: drop and channel stable with a 10 % jitter (runs outside the bound)".into(),
-        value: Some(failing as f64),
         threshold: Some(0.0),
-        pass: jittered.len() == 2 && failing == 0,
-        note: (jittered.len() != 2).then(|| "not run for both cases".to_string()),
-    });
-    out
+        pass,
+        note: note.map(str::to_string),
+    };
+    specs
+        .iter()
+        .filter_map(|c| match c {
+            Check::Explained { name } => {
+                let unexplained = rows
+                    .iter()
+                    .flat_map(|r| &r.trials)
+                    .filter(|t| !(t.status == "ok" || t.status.starts_with("diverged: ")))
+                    .count();
+                let n = (panics + unexplained) as f64;
+                Some(result(name, Some(n), n <= 0.0, None))
+            }
+            Check::Bound(spec) => spec.applies(tier).then(|| {
+                spec.evaluate(rows, tier).unwrap_or_else(|| CheckResult {
+                    name: spec.display_name(),
+                    value: None,
+                    threshold: spec.threshold(),
+                    pass: false,
+                    note: spec.missing.clone(),
+                })
+            }),
+            Check::Jittered { name, preset, fraction, rows: expected, missing } => {
+                let jittered: Vec<&Row> = rows
+                    .iter()
+                    .filter(|r| r.study == "jitter" && r.run.preset == *preset)
+                    .filter(|r| {
+                        r.run.metrics.get("jitter_fraction").is_some_and(|f| (f - fraction).abs() < 1e-12)
+                    })
+                    .collect();
+                let failing = jittered.iter().filter(|r| !r.trials.iter().all(|t| t.stable)).count();
+                let complete = jittered.len() == *expected;
+                Some(result(
+                    name,
+                    Some(failing as f64),
+                    complete && failing == 0,
+                    (!complete).then_some(missing),
+                ))
+            }
+        })
+        .collect()
 }
 
 /// `results.json` of a previous study in `out`, if any.
@@ -936,10 +813,41 @@ pub fn load(out: &Path) -> Option<StabilityResults> {
     io::read_json(&out.join(NAME).join("results.json")).ok()
 }
 
+/// The report index's link to the study's page, when `out` holds a study.
+pub fn extra_page(out: &Path) -> Option<crate::report::ExtraPage> {
+    load(out).map(|s| s.index_entry())
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::io::testing::Scratch;
+
+    fn validation() -> PathBuf {
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation")
+    }
+
+    /// A few seconds in all: coarse drop and channel, short runs, one bisection step.
+    fn tiny(option_sets: &[&str]) -> Config {
+        let mut config = Config::load(&validation()).unwrap();
+        config.settings = Settings {
+            drop_dx: 0.1,
+            drop_end: 4e-4,
+            long_end: 6e-4,
+            channel_dx: 0.2 / 12.0,
+            channel_tau: 0.02,
+            dt_range: [0.5, 4.0],
+            dt_iterations: 1,
+            re_range: [4.0, 400.0],
+            re_iterations: 1,
+            jitter: vec![0.2],
+            seed: 1,
+            drop_bound: 0.02,
+            channel_bound: 0.05,
+            option_sets: option_sets.iter().map(|s| s.to_string()).collect(),
+        };
+        config
+    }
 
     #[test]
     fn stability_joins_the_cases_by_name_or_in_the_full_tier() {
@@ -956,56 +864,67 @@ mod tests {
             split_cases(&names(&["elliptical_drop"]), Tier::Full),
             (names(&["elliptical_drop"]), true, false)
         );
+        // The study's file is not a case: discovery does not see it.
+        assert!(!crate::case::known_cases(&validation()).unwrap().iter().any(|c| c == NAME));
     }
 
     #[test]
     fn option_sets_patch_valid_scenes() {
-        let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation");
-        let case = Case::load(&dir.join("elliptical_drop.json")).unwrap();
-        let base = Base { case, short: "drop", preset: "paper", dx: 0.04, bound: 0.02 };
-        for &(set, _) in OPTION_SETS.iter().filter(|(s, _)| scheme_of(s) == "isph") {
-            let v = base.scene(set, |_| {}).unwrap();
-            let scene = meniscus::Scene::from_json(&v.to_string()).unwrap_or_else(|e| panic!("{set}: {e}"));
-            let meniscus::scene::Scheme::Isph(o) = &scene.scheme else { panic!("{set}: not an ISPH scene") };
-            match set {
-                "none" => assert_eq!(o.shifting, meniscus::scene::Shifting::None),
-                "fickian" => assert!(matches!(o.shifting, meniscus::scene::Shifting::Fickian { .. })),
-                _ => assert!(matches!(o.shifting, meniscus::scene::Shifting::Xu { .. })),
+        let config = Config::load(&validation()).unwrap();
+        let drop = Base::drop(&config, &validation()).unwrap();
+        let channel = Base::channel(&config, &validation()).unwrap();
+        let parse = |v: Value| meniscus::Scene::from_json(&v.to_string()).unwrap();
+        for set in &config.option_sets {
+            for base in [&drop, &channel] {
+                let scene = parse(base.scene(set, |_| {}).unwrap());
+                assert_eq!(scene.scheme.key(), set.scheme, "{} on {}", set.name, base.case.case);
+                match (&scene.scheme, set.name.as_str()) {
+                    (meniscus::scene::Scheme::Isph(o), "none") => {
+                        assert_eq!(o.shifting, meniscus::scene::Shifting::None)
+                    }
+                    (meniscus::scene::Scheme::Isph(o), "fickian") => {
+                        assert!(matches!(o.shifting, meniscus::scene::Shifting::Fickian { .. }))
+                    }
+                    (meniscus::scene::Scheme::Isph(o), _) => {
+                        assert!(matches!(o.shifting, meniscus::scene::Shifting::Xu { .. }))
+                    }
+                    (meniscus::scene::Scheme::Wcsph(o), name) => {
+                        assert_eq!(
+                            matches!(o.shifting, meniscus::scene::Shifting::Xu { .. }),
+                            name == "wcsph_xu"
+                        )
+                    }
+                }
             }
         }
-        assert!(base.scene("bogus", |_| {}).is_err());
         // WCSPH: the drop's tuned preset; the channel at Mach 0.1 of its (edited) force.
-        let v = base.scene(WCSPH, |_| {}).unwrap();
-        let scene = meniscus::Scene::from_json(&v.to_string()).unwrap();
-        let meniscus::scene::Scheme::Wcsph(o) = &scene.scheme else { panic!("not a WCSPH scene") };
+        let wcsph = config.option_set("wcsph").unwrap();
+        let meniscus::scene::Scheme::Wcsph(o) = parse(drop.scene(wcsph, |_| {}).unwrap()).scheme else {
+            panic!("not a WCSPH scene")
+        };
         assert!((o.sound_speed - 1000.0).abs() < 1e-12, "{}", o.sound_speed);
-        let case = Case::load(&dir.join("poiseuille_periodic.json")).unwrap();
-        let channel = Base { case, short: "channel", preset: "re40", dx: 0.2 / 18.0, bound: 0.05 };
-        let v = channel.scene(WCSPH, |v| v["body_force"] = json!([6e-7, 0.0])).unwrap();
-        let scene = meniscus::Scene::from_json(&v.to_string()).unwrap();
-        let meniscus::scene::Scheme::Wcsph(o) = &scene.scheme else { panic!("not a WCSPH scene") };
+        let v = channel.scene(wcsph, |v| v["body_force"] = json!([6e-7, 0.0])).unwrap();
+        let meniscus::scene::Scheme::Wcsph(o) = parse(v).scheme else { panic!("not a WCSPH scene") };
         // u_max = F D² / (8 ν) = 6e-7 × 0.04 / 8e-6 = 3e-3 m/s (Re = 400).
         assert!((o.sound_speed - 0.03).abs() < 1e-12, "{}", o.sound_speed);
-        assert_eq!(o.shifting, meniscus::scene::Shifting::None);
-        let v = channel.scene(WCSPH_XU, |_| {}).unwrap();
-        let scene = meniscus::Scene::from_json(&v.to_string()).unwrap();
-        let meniscus::scene::Scheme::Wcsph(o) = &scene.scheme else { panic!("not a WCSPH scene") };
-        assert!(matches!(o.shifting, meniscus::scene::Shifting::Xu { .. }));
+        assert!(o.artificial_viscosity.is_some_and(|a| a.alpha.abs() < 1e-15 && a.beta.abs() < 1e-15));
+        assert!(o.density_diffusion.is_some_and(|d| (d - 0.1).abs() < 1e-15));
     }
 
-    /// The whole runner on tiny settings: every study gives its rows, the page and the
-    /// results file are written, the index links the page, and a second run reuses the cache.
+    /// The whole study on tiny settings: every study gives its rows, the page and the
+    /// results file are written, the index links the page, and a second run reuses the
+    /// cache, two runs at a time.
     #[test]
     fn tiny_envelope_produces_rows() {
         let dir = Scratch::new("stability");
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
         let opts = StabilityOptions {
             out: dir.path().join("reports"),
-            validation_dir: root.join("validation"),
+            validation_dir: validation(),
             workspace: dir.path().to_path_buf(),
             tier: Tier::Full,
-            settings: Settings { option_sets: vec!["xu".into(), WCSPH.into()], ..Settings::tiny() },
+            config: tiny(&["xu", "wcsph"]),
             force: false,
+            jobs: 1,
             progress: false,
         };
         let res = run(&opts).unwrap();
@@ -1028,33 +947,83 @@ mod tests {
                 ("long_run", "elliptical_drop"),
             ]
         );
-        assert!(res.runs[..6].iter().all(|r| r.scheme == "isph" && r.preset == "xu"));
-        assert!(res.runs[6..].iter().all(|r| r.scheme == "wcsph" && r.preset == WCSPH));
+        assert!(res.runs[..6].iter().all(|r| r.run.scheme == "isph" && r.run.preset == "xu"));
+        assert!(res.runs[6..].iter().all(|r| r.run.scheme == "wcsph" && r.run.preset == "wcsph"));
         assert_eq!(res.scheme, "isph, wcsph");
         for r in &res.runs {
             assert!(!r.trials.is_empty() && !r.outcome.is_empty(), "{r:?}");
-            assert!(r.status == "ok" || r.status.starts_with("diverged: "), "{}", r.status);
+            assert!(r.run.status == "ok" || r.run.status.starts_with("diverged: "), "{}", r.run.status);
         }
         // One bisection step: both ends and one midpoint, unless an end decided.
         let dt = &res.runs[0];
         assert!(matches!(dt.trials.len(), 1..=3), "{:?}", dt.trials);
         assert!(dt.measured.starts_with("k "));
         let long = &res.runs[5];
-        assert!(long.metrics["ke_drift"].is_finite() && !long.series["e"].is_empty());
+        assert!(long.run.metrics["ke_drift"].is_finite() && !long.run.series["e"].is_empty());
         assert!(res.complete && res.checks.len() == 12);
         assert_eq!(res.checks[0].value, Some(0.0), "no panic");
         assert!(res.executed > 0 && res.reused == 0);
         let back: StabilityResults = io::read_json(&opts.out.join("stability/results.json")).unwrap();
-        assert_eq!(back.runs.len(), res.runs.len());
+        let json = |r: &StabilityResults| serde_json::to_value(r).unwrap();
+        assert_eq!(json(&back), json(&res), "results.json round-trips (NaN as null)");
         let page = std::fs::read_to_string(opts.out.join("stability/index.html")).unwrap();
         assert!(page.contains("dt_max") && page.contains("long_run") && page.contains("jitter"));
         let index = std::fs::read_to_string(opts.out.join("index.html")).unwrap();
         assert!(index.contains("stability/index.html"), "the index links the page");
-        let again = run(&opts).unwrap();
+        let again = run(&StabilityOptions { jobs: 2, ..opts.clone() }).unwrap();
         assert_eq!((again.executed, again.reused), (0, res.executed), "every run cached");
         assert_eq!(
             again.runs.iter().map(|r| &r.measured).collect::<Vec<_>>(),
             res.runs.iter().map(|r| &r.measured).collect::<Vec<_>>()
         );
+    }
+
+    /// The checks of the committed file on hand-made rows: a bound check reads the row's
+    /// metric whatever its status, a missing row fails with the file's note, a panic
+    /// counts, the jitter check wants both cases.
+    #[test]
+    fn checks_read_the_rows() {
+        let specs = Config::load(&validation()).unwrap().checks;
+        let row = |study: &str, case: &str, preset: &str, metrics: &[(&str, f64)]| Row {
+            run: RunResult {
+                scheme: "isph".into(),
+                preset: preset.into(),
+                dx: 0.04,
+                particles: 1,
+                steps: 1,
+                wall_s: 1.0,
+                status: "diverged: at step 3".into(),
+                metrics: metrics.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
+                series: BTreeMap::new(),
+            },
+            study: study.into(),
+            case: case.into(),
+            config: String::new(),
+            measured: String::new(),
+            outcome: String::new(),
+            trials: Vec::new(),
+        };
+        let rows = vec![
+            row("dt_max", "elliptical_drop", "xu", &[("dt_multiple_max", 1.19)]),
+            row("dt_max", "poiseuille_periodic", "xu", &[("dt_multiple_max", f64::NAN)]),
+            row("jitter", "elliptical_drop", "xu", &[("jitter_fraction", 0.1)]),
+        ];
+        let out = checks(&specs, &rows, 1, Tier::Default);
+        assert_eq!(out.len(), 12);
+        assert_eq!((out[0].value, out[0].pass), (Some(1.0), false), "one panic");
+        assert_eq!((out[1].value, out[1].threshold, out[1].pass), (Some(1.19), Some(1.0), true));
+        assert_eq!(
+            out[1].name,
+            "drop (xu): largest stable multiple of the adaptive step ≥ 1 (Qiu's α = 0.2)"
+        );
+        let not_run = Some("not run (no result, or unstable over the whole range)".to_string());
+        assert_eq!(
+            (out[2].value, out[2].pass, &out[2].note),
+            (None, false, &not_run),
+            "NaN: unstable everywhere"
+        );
+        assert_eq!((out[3].value, out[3].pass, &out[3].note), (None, false, &not_run), "no row");
+        assert_eq!((out[11].value, out[11].pass), (Some(0.0), false));
+        assert_eq!(out[11].note.as_deref(), Some("not run for both cases"));
     }
 }

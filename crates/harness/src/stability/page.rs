@@ -1,7 +1,7 @@
 //! `reports/stability/index.html`: the envelope's rows, grouped by study, self-contained.
 
-use super::{Row, StabilityResults, pct};
-use crate::report::html::{ExtraPage, format_dx, page as html_page, pass_cell};
+use super::{Config, Row, StabilityResults, pct};
+use crate::report::html::{ExtraPage, checks_table, format_dx, page as html_page};
 use maud::{Markup, html};
 
 impl StabilityResults {
@@ -79,20 +79,20 @@ fn row(r: &Row) -> Markup {
     html! {
         tr {
             td class="l" { (r.case) }
-            td class="l" { code { (r.preset) } }
-            td { (format_dx(r.dx)) }
-            td { (r.particles) }
+            td class="l" { code { (r.run.preset) } }
+            td { (format_dx(r.run.dx)) }
+            td { (r.run.particles) }
             td class="l" { b { (r.measured) } }
             td class=(if stable { "l pass" } else { "l fail" }) { (r.outcome) }
             td { (r.trials.len()) }
-            td { (format!("{:.1}", r.wall_s)) }
+            td { (format!("{:.1}", r.run.wall_s)) }
             td class="l note" { (r.config) br; (trials_text(r)) }
         }
     }
 }
 
-/// The page.
-pub fn render(res: &StabilityResults) -> String {
+/// The page of `res`, the option sets described as in `config`.
+pub fn render(res: &StabilityResults, config: &Config) -> String {
     let s = &res.settings;
     let (passed, failed) = res.counts();
     let trials: usize = res.runs.iter().map(|r| r.trials.len()).sum();
@@ -120,22 +120,11 @@ pub fn render(res: &StabilityResults) -> String {
         }
         p class=(if failed == 0 { "pass" } else { "fail" }) { (passed) " / " (passed + failed) " checks passed" }
         h2 { "Checks" }
-        table {
-            tr { th class="l" { "check" } th { "value" } th { "threshold" } th { "result" } th class="l" { "note" } }
-            @for c in &res.checks {
-                tr {
-                    td class="l" { (c.name) }
-                    td { (c.value.map_or("—".to_string(), |v| format!("{v:.4}"))) }
-                    td { (c.threshold.map_or("—".to_string(), |v| format!("{v:.4}"))) }
-                    (pass_cell(c.pass))
-                    td class="l" { (c.note.as_deref().unwrap_or("")) }
-                }
-            }
-        }
+        (checks_table(&res.checks, |v| format!("{v:.4}")))
         h2 { "Option sets" }
         ul {
-            @for (name, what) in super::OPTION_SETS {
-                @if s.option_sets.iter().any(|o| o == name) { li { code { (name) } ": " (what) } }
+            @for set in config.option_sets.iter().filter(|o| s.option_sets.contains(&o.name)) {
+                li { code { (set.name) } ": " (set.description) }
             }
         }
         @for (study, title, what) in STUDIES {

@@ -11,13 +11,14 @@
 //! two-level preconditioner, whose coarse null space is grounded: the periodic mirror
 //! channel has no Dirichlet row).
 
-use super::Outcome;
-use crate::case::{Case, Tier};
+use super::record::Cost;
+use crate::case::Case;
 use crate::error::{HarnessError, Result};
+use crate::runner::Ran;
+use crate::tier::Tier;
 use meniscus::Scene;
 use meniscus::scene::schema::{PpeSolver, Preconditioner, Scheme, Shifting, ViscousIntegration};
 use serde::{Deserialize, Serialize};
-use std::collections::BTreeMap;
 
 /// The case file of the study (`validation/<CASE>.json`).
 pub const CASE: &str = "poiseuille_periodic";
@@ -231,26 +232,18 @@ pub struct ChannelRow {
     pub preset: Option<String>,
     /// Rayon threads.
     pub threads: usize,
-    /// Particles (fluid).
-    pub particles: usize,
-    /// Steps taken.
-    pub steps: usize,
-    /// Time reached \[s\].
-    pub t_end: f64,
-    /// Wall time of the stepping loop \[s\].
-    pub wall_s: f64,
-    /// CPU time of the process over the run \[s\] (see `RunRow::cpu_s`).
-    pub cpu_s: Option<f64>,
-    /// Seconds per stage.
-    pub stages: BTreeMap<String, f64>,
-    /// Mean PPE iterations per step.
-    pub ppe_iterations_mean: f64,
+    /// Size and cost of the run.
+    #[serde(flatten)]
+    pub cost: Cost,
     /// Steady profile error at τ = 1 (`u_profile_l2_rel_steady`); `None` when diverged.
     pub error: Option<f64>,
     /// Largest start-up profile error, τ < 1 (`u_profile_l2_rel_startup_max`).
     pub error_startup_max: Option<f64>,
     /// `ok` or `diverged: <cause>`.
     pub status: String,
+    /// Taken from the run cache of an earlier invocation (see `RunRow::reused`).
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub reused: bool,
 }
 
 impl ChannelRow {
@@ -296,51 +289,40 @@ impl ChannelStudy {
             .runs
             .iter()
             .filter(|r| r.ok())
-            .filter_map(|r| r.error.filter(|e| e.is_finite()).map(|e| (r, (e, r.wall_s))))
+            .filter_map(|r| r.error.filter(|e| e.is_finite()).map(|e| (r, (e, r.cost.wall_s))))
             .collect();
         let xy: Vec<(f64, f64)> = pts.iter().map(|p| p.1).collect();
         self.pareto = super::pareto::front(&xy).into_iter().map(|i| pts[i].0.id.clone()).collect();
     }
 }
 
-/// The row of a planned run from its outcome.
-pub fn row(case: &Case, planned: &ChannelPlanned, scene: &Scene, outcome: Outcome) -> Result<ChannelRow> {
-    let (id, cpu_s) = (planned.id(), outcome.cpu_s);
-    let m = super::measure(case, scene, outcome)?;
+/// The row of a planned run from how it ran.
+pub fn row(case: &Case, planned: &ChannelPlanned, ran: &Ran) -> Result<ChannelRow> {
+    let m = super::measure(case, ran)?;
     let get = |k: &str| m.metrics.get(k).copied();
     Ok(ChannelRow {
+        id: planned.id(),
         dx: planned.dx,
         variant: planned.variant,
         preset: planned.variant.preset().map(str::to_string),
         threads: planned.threads,
-        particles: m.particles,
-        steps: m.steps,
-        t_end: m.t_end,
-        wall_s: m.wall_s,
-        cpu_s,
         error: get(METRIC),
         error_startup_max: get("u_profile_l2_rel_startup_max"),
-        stages: m.stages,
-        ppe_iterations_mean: m.ppe_iterations_mean,
+        cost: m.cost,
         status: m.status,
-        id,
+        reused: ran.reused(),
     })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::case::testing::committed;
     use std::collections::HashSet;
-    use std::path::Path;
-
-    fn case() -> Case {
-        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/poiseuille_periodic.json"))
-            .unwrap()
-    }
 
     #[test]
     fn presets_match_the_case_file() {
-        let c = case();
+        let c = committed("poiseuille_periodic");
         for v in [ChannelVariant::EXPLICIT, ChannelVariant::IMPLICIT] {
             let name = v.preset().unwrap();
             for dx in [D36, 0.0025] {

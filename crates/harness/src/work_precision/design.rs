@@ -9,8 +9,9 @@
 //! below Δx = 0.04 (see [`Design::for_tier`]). The two presets are also run with one
 //! thread at every spacing of the thread study, for the speed-up.
 
-use crate::case::{Case, Tier};
+use crate::case::Case;
 use crate::error::{HarnessError, Result};
+use crate::tier::Tier;
 use meniscus::Scene;
 use meniscus::scene::{Divergence, PpeSolver, Preconditioner, PressureGradient, Scheme, Shifting, TimeStep};
 use serde::{Deserialize, Serialize};
@@ -386,17 +387,12 @@ pub fn scene(case: &Case, variant: &Variant, dx: f64) -> Result<Scene> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::case::testing::committed;
     use std::collections::HashSet;
-    use std::path::Path;
-
-    fn case() -> Case {
-        Case::load(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../../validation/elliptical_drop.json"))
-            .unwrap()
-    }
 
     #[test]
     fn presets_match_the_case_file() {
-        let c = case();
+        let c = committed("elliptical_drop");
         for (name, v) in [("paper", Variant::PAPER), ("tuned", Variant::TUNED)] {
             for dx in [0.04, 0.01] {
                 let spec = crate::sweep::spec(&c, name, dx).unwrap();
@@ -409,7 +405,7 @@ mod tests {
 
     #[test]
     fn factors_reach_the_scene() {
-        let c = case();
+        let c = committed("elliptical_drop");
         let v = Variant {
             ppe: Ppe::Cg3,
             gradient: Gradient::Difference,

@@ -2,18 +2,26 @@
 //! Poiseuille channel ([`channel`]).
 //!
 //! Every run of a pruned design over spacing × PPE solver and tolerance × gradient form ×
-//! divergence form × shifting × time-step rule ([`design`]) goes through the solver
-//! in-process, one run at a time, each on a rayon pool of the requested thread count. Per
-//! run the study records wall time, steps, particles, seconds per stage, mean PPE
-//! iterations, the b error at t = 0.008 s against the ellipse ODE (the harness's
-//! elliptical-drop metrics) and the status; a diverged run is a row, never an abort.
-//! From the rows alone it then derives the Pareto front, the cost-per-step fits and the
-//! speed-ups and evaluates the performance issue's targets ([`targets`]), draws the figures
-//! ([`plots`]) and writes `results.json`, one SVG per figure and `index.html` into the
-//! output directory, atomically (`results.json` is also rewritten, marked incomplete,
-//! after every run, so an interrupted study keeps what it measured). The channel's runs
-//! follow the drop's and are recorded in the `channel` field of `results.json`, with their
-//! own Pareto front and figure; the targets are the drop's.
+//! divergence form × shifting × time-step rule ([`design`]) goes through the harness's
+//! runner ([`crate::runner`]), one run at a time, each on a rayon pool of the requested
+//! thread count. Per run the study records wall time, steps, particles, seconds per stage,
+//! mean PPE iterations, the process CPU time, the b error at t = 0.008 s against the
+//! ellipse ODE (the harness's elliptical-drop metrics) and the status; a diverged run (or
+//! one whose solver panicked) is a row, never an abort. From the rows alone it then derives
+//! the Pareto front, the cost-per-step fits and the speed-ups and evaluates the performance
+//! issue's targets ([`targets`]), draws the figures ([`plots`]) and writes `results.json`,
+//! one SVG per figure and `index.html` into the output directory, atomically
+//! (`results.json` is also rewritten, marked incomplete, after every run, so an interrupted
+//! study keeps what it measured). The channel's runs follow the drop's and are recorded in
+//! the `channel` field of `results.json`, with their own Pareto front and figure; the
+//! targets are the drop's.
+//!
+//! Reuse: every run's record is cached in `<out>/runs/<id>.json`, but a study measures
+//! every run again by default, so that all its times come from one invocation under one
+//! machine load (recorded in `machine`). `resume` (`cargo xtask bench --resume`) reuses the
+//! records of the same build and scenes, to finish an interrupted study: a reused row is
+//! marked `reused` in `results.json` and on the page, and its times are those measured when
+//! it ran.
 
 pub mod channel;
 pub mod design;
@@ -23,15 +31,21 @@ pub mod plots;
 pub mod record;
 pub mod targets;
 
-use crate::case::{Case, Tier};
-use crate::error::{HarnessError, Result};
+use crate::case::Case;
+use crate::error::Result;
 use crate::io;
 use crate::metrics;
+use crate::progress::Progress;
 use crate::provenance::Provenance;
+use crate::runner::{Job, Ran, Runner};
+use crate::sweep::RunSpec;
+use crate::tier::Tier;
 use channel::ChannelStudy;
 use design::{Design, Planned, Ppe, Variant};
-use record::{Machine, RunRow, Study};
+use record::{Cost, Machine, RunRow, Study};
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 use std::time::Instant;
 
 /// Options of a study.
@@ -49,25 +63,12 @@ pub struct Options {
     pub threads: usize,
     /// Print one line per run on stderr.
     pub progress: bool,
+    /// Reuse the cached runs of an earlier invocation (see the module documentation).
+    pub resume: bool,
 }
 
 /// The case the study runs.
 pub const CASE: &str = "elliptical_drop";
-
-fn study_error(message: impl Into<String>) -> HarnessError {
-    HarnessError::case("work_precision", message)
-}
-
-/// CPU time of this process, user + system, all threads \[s\] (`/proc/self/stat` fields 14
-/// and 15, in clock ticks of 1/100 s, the Linux value); `None` off Linux.
-fn process_cpu_s() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
-    // Fields after the command name (which may hold spaces) start at field 3.
-    let rest = &stat[stat.rfind(')')? + 1..];
-    let f: Vec<&str> = rest.split_whitespace().collect();
-    let ticks = f.get(11)?.parse::<f64>().ok()? + f.get(12)?.parse::<f64>().ok()?;
-    Some(ticks / 100.0)
-}
 
 fn loadavg() -> Option<String> {
     std::fs::read_to_string("/proc/loadavg")
@@ -75,35 +76,10 @@ fn loadavg() -> Option<String> {
         .map(|s| s.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
 }
 
-/// What running one scene gave: the solver's report, or the message of a panic inside it;
-/// and the process CPU time over the run.
-pub struct Outcome {
-    /// The report (which may carry a divergence), or the panic message.
-    pub report: std::result::Result<meniscus::RunReport, String>,
-    /// CPU time of the process over the run \[s\] (`None` off Linux).
-    pub cpu_s: Option<f64>,
-}
-
-/// Runs `scene` on `pool`; a panic inside the solver is caught and becomes the outcome.
-fn run_scene(
-    scene: &meniscus::Scene,
-    pool: &rayon::ThreadPool,
-) -> std::result::Result<Outcome, meniscus::SceneError> {
-    let cpu0 = process_cpu_s();
-    let outcome = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-        pool.install(|| meniscus::run(scene, &mut meniscus::Quiet))
-    }));
-    let cpu_s = process_cpu_s().zip(cpu0).map(|(b, a)| b - a);
-    let report = match outcome {
-        Ok(Ok(report)) => Ok(report),
-        Ok(Err(source)) => return Err(source),
-        Err(panic) => Err(panic
-            .downcast_ref::<String>()
-            .cloned()
-            .or_else(|| panic.downcast_ref::<&str>().map(|s| s.to_string()))
-            .unwrap_or_else(|| "unknown".into())),
-    };
-    Ok(Outcome { report, cpu_s })
+/// A job of the study: run `id` of `case` with `scene`, on `threads` threads.
+fn job(case: &Case, id: String, dx: f64, scene: meniscus::Scene, threads: usize) -> Result<Job> {
+    let preset = id.clone();
+    Ok(Job { spec: RunSpec::new(&case.case, id, &preset, dx, scene)?, threads: Some(threads) })
 }
 
 /// Runs the study and writes its directory; missed targets are results, not errors.
@@ -115,7 +91,7 @@ pub fn run(opts: &Options) -> Result<Study> {
     let (channel_runs, channel_design) = channel::design(opts.tier, threads);
     let mut provenance = Provenance::collect(&opts.workspace);
     provenance.threads = threads;
-    let mut study = Study {
+    let study = Mutex::new(Study {
         study: "work_precision".into(),
         case: CASE.into(),
         tier: opts.tier.name().into(),
@@ -137,57 +113,62 @@ pub fn run(opts: &Options) -> Result<Study> {
         speedups: Vec::new(),
         targets: Vec::new(),
         channel: Some(ChannelStudy::new(channel_design)),
-    };
-    let mut pools = Vec::new();
-    for &k in &design.thread_counts {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(k)
-            .build()
-            .map_err(|e| study_error(format!("cannot build a rayon pool of {k} threads: {e}")))?;
-        pools.push((k, pool));
-    }
+    });
     let start = Instant::now();
     let total = design.runs.len() + channel_runs.len();
-    let pool_of =
-        |threads: usize| &pools.iter().find(|(k, _)| *k == threads).expect("a pool per thread count").1;
-    let progress = |i: usize, id: &str, wall_s: f64, cpu_s: Option<f64>, error: String, status: &str| {
-        if opts.progress {
-            eprintln!(
-                "[{:>3}/{total}] {:<52} {:>8.2} s (CPU/wall {:>4})  {error}  {status}  ({:.0} s elapsed)",
-                i + 1,
-                id,
-                wall_s,
-                cpu_s.map_or("—".into(), |c| format!("{:.2}", c / wall_s.max(1e-12))),
-                start.elapsed().as_secs_f64()
-            );
-        }
+    let progress = if opts.progress { Progress::new(true) } else { Progress::silent() };
+    let runner = Runner::new(progress, !opts.resume, 1);
+    // One line per run, and results.json rewritten with the run's row.
+    let record = |i: usize,
+                  id: &str,
+                  cost: &Cost,
+                  error: String,
+                  status: &str,
+                  reused: bool,
+                  add: &dyn Fn(&mut Study)| {
+        let mut s = study.lock().unwrap_or_else(|e| e.into_inner());
+        add(&mut s);
+        s.elapsed_s = start.elapsed().as_secs_f64();
+        io::write_json(&opts.out.join("results.json"), &*s)?;
+        let cpu = cost.cpu_s.map_or("—".into(), |c| format!("{:.2}", c / cost.wall_s.max(1e-12)));
+        Ok(format!(
+            "[{:>3}/{total}] {:<52} {:>8.2} s (CPU/wall {:>4})  {error}  {status}  ({:.0} s elapsed){}",
+            i + 1,
+            id,
+            cost.wall_s,
+            cpu,
+            start.elapsed().as_secs_f64(),
+            if reused { " cached" } else { "" }
+        ))
     };
     let pct = |e: Option<f64>| e.map_or("—".into(), |e| format!("{:.3} %", 100.0 * e));
-    for (i, planned) in design.runs.iter().enumerate() {
-        let row = execute(&case, planned, pool_of(planned.threads))?;
+    let jobs = design
+        .runs
+        .iter()
+        .map(|p| job(&case, p.id(), p.dx, design::scene(&case, &p.variant, p.dx)?, p.threads))
+        .collect::<Result<Vec<_>>>()?;
+    runner.run(&opts.out, None, &jobs, |i, ran| {
+        let row = drop_row(&case, &design.runs[i], &ran)?;
         let status = if row.ok() { "ok" } else { &row.status };
-        progress(i, &row.id, row.wall_s, row.cpu_s, format!("b err {:>9}", pct(row.b_err)), status);
-        study.runs.push(row);
-        study.elapsed_s = start.elapsed().as_secs_f64();
-        io::write_json(&opts.out.join("results.json"), &study)?;
-    }
-    for (i, planned) in channel_runs.iter().enumerate() {
-        let scene = channel::scene(&channel_case, &planned.variant, planned.dx)?;
-        let outcome = run_scene(&scene, pool_of(planned.threads)).map_err(|source| HarnessError::Scene {
-            case: channel_case.case.clone(),
-            run: planned.id(),
-            source,
-        })?;
-        let row = channel::row(&channel_case, planned, &scene, outcome)?;
+        let error = format!("b err {:>9}", pct(row.b_err));
+        let line = record(i, &row.id, &row.cost, error, status, row.reused, &|s| s.runs.push(row.clone()))?;
+        Ok(((), line))
+    })?;
+    let jobs = channel_runs
+        .iter()
+        .map(|p| {
+            job(&channel_case, p.id(), p.dx, channel::scene(&channel_case, &p.variant, p.dx)?, p.threads)
+        })
+        .collect::<Result<Vec<_>>>()?;
+    runner.run(&opts.out, None, &jobs, |i, ran| {
+        let row = channel::row(&channel_case, &channel_runs[i], &ran)?;
         let status = if row.ok() { "ok" } else { &row.status };
         let error = format!("profile err {:>9}", pct(row.error));
-        progress(design.runs.len() + i, &row.id, row.wall_s, row.cpu_s, error, status);
-        if let Some(c) = &mut study.channel {
-            c.runs.push(row);
-        }
-        study.elapsed_s = start.elapsed().as_secs_f64();
-        io::write_json(&opts.out.join("results.json"), &study)?;
-    }
+        let add = |s: &mut Study| s.channel.iter_mut().for_each(|c| c.runs.push(row.clone()));
+        let line = record(design.runs.len() + i, &row.id, &row.cost, error, status, row.reused, &add)?;
+        Ok(((), line))
+    })?;
+    let mut study = study.into_inner().unwrap_or_else(|e| e.into_inner());
     study.elapsed_s = start.elapsed().as_secs_f64();
     study.machine.loadavg_end = loadavg();
     study.complete = true;
@@ -212,93 +193,67 @@ pub fn derive(study: &mut Study, tier: Tier) {
     }
 }
 
-/// Runs one planned point on `pool`; a divergence (or a panic inside the solver) becomes
-/// the row's status.
-fn execute(case: &Case, planned: &Planned, pool: &rayon::ThreadPool) -> Result<RunRow> {
-    let scene = design::scene(case, &planned.variant, planned.dx)?;
-    let id = planned.id();
-    let outcome = run_scene(&scene, pool).map_err(|source| HarnessError::Scene {
-        case: case.case.clone(),
-        run: id.clone(),
-        source,
-    })?;
-    let cpu_s = outcome.cpu_s;
-    let m = measure(case, &scene, outcome)?;
+/// The row of a planned drop run from how it ran; a divergence (or a panic inside the
+/// solver) is the row's status.
+fn drop_row(case: &Case, planned: &Planned, ran: &Ran) -> Result<RunRow> {
+    let m = measure(case, ran)?;
     let get = |k: &str| m.metrics.get(k).copied();
     Ok(RunRow {
+        id: planned.id(),
         dx: planned.dx,
         variant: planned.variant,
         preset: planned.variant.preset().map(str::to_string),
         threads: planned.threads,
         groups: planned.groups.clone(),
-        particles: m.particles,
-        steps: m.steps,
-        t_end: m.t_end,
-        wall_s: m.wall_s,
-        cpu_s,
         b_err: get("b_rel_err_final"),
         b_err_max: get("b_rel_err_max"),
         a_err: get("a_rel_err_final"),
-        stages: m.stages,
-        ppe_iterations_mean: m.ppe_iterations_mean,
+        cost: m.cost,
         status: m.status,
-        id,
+        reused: ran.reused(),
     })
 }
 
 /// What a work-precision row takes from a run: its size and cost, its status, and the
 /// case's finite metrics when it reached its end time (none after a divergence).
 pub(crate) struct Measured {
-    pub particles: usize,
-    pub steps: usize,
-    pub t_end: f64,
-    pub wall_s: f64,
-    pub stages: std::collections::BTreeMap<String, f64>,
-    pub ppe_iterations_mean: f64,
+    pub cost: Cost,
     pub status: String,
-    pub metrics: std::collections::BTreeMap<String, f64>,
+    pub metrics: BTreeMap<String, f64>,
 }
 
-/// Reads the `outcome` of a run of `scene`: a panic or a divergence becomes the status
+/// Reads how a run of `case` went: a panic or a divergence becomes the status
 /// (`diverged: …`), a finished run gets the metrics of `case`'s reference.
-pub(crate) fn measure(case: &Case, scene: &meniscus::Scene, outcome: Outcome) -> Result<Measured> {
-    let mut m = Measured {
-        particles: 0,
-        steps: 0,
-        t_end: 0.0,
-        wall_s: 0.0,
-        stages: Default::default(),
-        ppe_iterations_mean: 0.0,
-        status: "ok".into(),
-        metrics: Default::default(),
+pub(crate) fn measure(case: &Case, ran: &Ran) -> Result<Measured> {
+    let status = ran.status();
+    let Some(record) = ran.record() else {
+        return Ok(Measured { cost: Cost::default(), status, metrics: BTreeMap::new() });
     };
-    let report = match outcome.report {
-        Ok(report) => report,
-        Err(msg) => {
-            m.status = format!("diverged: the solver panicked: {msg}");
-            return Ok(m);
-        }
+    let s = &record.summary;
+    let cost = Cost {
+        particles: s.particles,
+        steps: s.steps,
+        t_end: s.t_end,
+        wall_s: s.wall_s,
+        cpu_s: record.cpu_s,
+        stages: s.stages.clone(),
+        ppe_iterations_mean: s.ppe_iterations_mean,
     };
-    let s = &report.summary;
-    (m.particles, m.steps, m.t_end, m.wall_s) = (s.particles, s.steps, s.t_end, s.wall_s);
-    m.stages = s.stages.clone();
-    m.ppe_iterations_mean = s.ppe_iterations_mean;
-    if let Some(e) = &report.error {
-        m.status = format!("diverged: {e}");
-        return Ok(m);
+    if status != "ok" {
+        return Ok(Measured { cost, status, metrics: BTreeMap::new() });
     }
-    let scene_json = serde_json::to_value(scene).unwrap_or_default();
-    let measured = metrics::compute(&case.reference, &scene_json, &report.probes, s.particles)
-        .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
-    m.metrics = measured.metrics.into_iter().filter(|(_, v)| v.is_finite()).collect();
-    Ok(m)
+    let probes = meniscus::ProbeRecord::from(record.probes.clone());
+    let measured = metrics::compute(&case.reference, &record.scene, &probes, s.particles)
+        .map_err(|source| crate::error::HarnessError::Reference { case: case.case.clone(), source })?;
+    let metrics = measured.metrics.into_iter().filter(|(_, v)| v.is_finite()).collect();
+    Ok(Measured { cost, status, metrics })
 }
 
 /// The runs shown in the stage breakdown: the presets at every spacing, and the PPE
 /// solver variants of both presets at Δx = 0.02.
 fn breakdown_bars(study: &Study) -> Vec<(String, &RunRow)> {
     let mut bars = Vec::new();
-    let main = |r: &&RunRow| r.threads == study.threads && r.steps > 0;
+    let main = |r: &&RunRow| r.threads == study.threads && r.cost.steps > 0;
     let mut dxs: Vec<f64> = study.runs.iter().map(|r| r.dx).collect();
     dxs.sort_by(|a, b| b.total_cmp(a));
     dxs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
@@ -387,9 +342,7 @@ mod tests {
 
     #[test]
     fn a_tiny_study_writes_well_formed_files() {
-        let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-        let case = Case::load(&root.join("validation/elliptical_drop.json")).unwrap();
-        let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+        let case = crate::case::testing::committed("elliptical_drop");
         let mut study = Study {
             study: "work_precision".into(),
             case: CASE.into(),
@@ -413,41 +366,63 @@ mod tests {
             targets: vec![],
             channel: Some(ChannelStudy::new("test".into())),
         };
+        let dir = Scratch::new("work-precision");
         // A short drop at a coarse spacing: end time cut to 10 steps.
         let mut short = case.clone();
         short.scene["time"]["end"] = serde_json::json!(2e-4);
-        for (v, threads) in [(Variant::PAPER, 2), (Variant::TUNED, 2), (Variant::PAPER, 1)] {
-            let planned = Planned { dx: 0.08, variant: v, threads, groups: vec!["test".into()] };
-            let row = execute(&short, &planned, &pool).unwrap();
-            assert!(row.ok(), "{}", row.status);
-            assert_eq!(row.steps, 10);
+        let planned: Vec<Planned> = [(Variant::PAPER, 2), (Variant::TUNED, 2), (Variant::PAPER, 1)]
+            .into_iter()
+            .map(|(variant, threads)| Planned { dx: 0.08, variant, threads, groups: vec!["test".into()] })
+            .collect();
+        let jobs: Vec<Job> = planned
+            .iter()
+            .map(|p| {
+                job(&short, p.id(), p.dx, design::scene(&short, &p.variant, p.dx).unwrap(), p.threads)
+                    .unwrap()
+            })
+            .collect();
+        let finish = |i: usize, ran: Ran| Ok((drop_row(&short, &planned[i], &ran)?, String::new()));
+        let runner = Runner::new(Progress::silent(), true, 1);
+        for row in runner.run(dir.path(), None, &jobs, finish).unwrap() {
+            assert!(row.ok() && !row.reused, "{}", row.status);
+            assert_eq!(row.cost.steps, 10);
             assert!(row.b_err.unwrap() < 0.05);
-            assert!(row.stages.contains_key("ppe_solve"));
-            assert!(row.cpu_s.is_some_and(|c| c >= 0.0));
+            assert!(row.cost.stages.contains_key("ppe_solve"));
+            assert!(row.cost.cpu_s.is_some_and(|c| c >= 0.0));
             study.runs.push(row);
         }
+        // Resumed: the rows come from the cache, with the times measured then.
+        let resumed = Runner::new(Progress::silent(), false, 1).run(dir.path(), None, &jobs, finish).unwrap();
+        assert!(resumed.iter().all(|r| r.reused));
+        assert_eq!(
+            resumed.iter().map(|r| &r.cost).collect::<Vec<_>>(),
+            study.runs.iter().map(|r| &r.cost).collect::<Vec<_>>()
+        );
+        study.runs[2].reused = true;
         // The channel with implicit viscosity at D/36 to τ = 1 (about 670 steps).
-        let ch_case = Case::load(&root.join("validation/poiseuille_periodic.json")).unwrap();
+        let ch_case = crate::case::testing::committed("poiseuille_periodic");
         let planned = channel::ChannelPlanned {
             dx: channel::D36,
             variant: channel::ChannelVariant::IMPLICIT,
             threads: 1,
         };
         let scene = channel::scene(&ch_case, &planned.variant, planned.dx).unwrap();
-        let row = channel::row(&ch_case, &planned, &scene, run_scene(&scene, &pool).unwrap()).unwrap();
+        let jobs = [job(&ch_case, planned.id(), planned.dx, scene, 1).unwrap()];
+        let finish = |_: usize, ran: Ran| Ok((channel::row(&ch_case, &planned, &ran)?, String::new()));
+        let row = runner.run(dir.path(), None, &jobs, finish).unwrap().remove(0);
         assert!(row.ok(), "{}", row.status);
-        assert_eq!((row.particles, row.preset.as_deref()), (648, Some("re4_implicit")));
+        assert_eq!((row.cost.particles, row.preset.as_deref()), (648, Some("re4_implicit")));
         assert!(row.error.is_some_and(|e| e < 0.05), "{:?}", row.error);
-        assert!(row.stages.contains_key("viscosity_implicit"));
+        assert!(row.cost.stages.contains_key("viscosity_implicit"));
         study.channel.as_mut().unwrap().runs.push(row);
         derive(&mut study, Tier::Quick);
         assert!(!study.pareto.is_empty());
         assert_eq!(study.channel.as_ref().unwrap().pareto.len(), 1);
         assert_eq!(study.targets.len(), 6);
-        let dir = Scratch::new("work-precision");
         write(dir.path(), &study).unwrap();
         let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
         assert!(html.contains("Targets") && html.contains("<svg"));
+        assert!(html.contains("1 runs (marked cached)") && html.contains(" (cached)"));
         assert!(html.contains("Periodic channel") && html.contains("re4_implicit"));
         for f in ["work_precision", "stages", "cost_scaling", "channel_work_precision"] {
             let svg = std::fs::read_to_string(dir.path().join(format!("{f}.svg"))).unwrap();

@@ -1,7 +1,7 @@
 //! The study's self-contained HTML page (maud; inline CSS, figures inlined as SVG).
 
 use super::channel::{ChannelRow, ChannelStudy};
-use super::record::{RunRow, Study};
+use super::record::{Cost, RunRow, Study};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
 const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1250px;color:#222}\
@@ -30,10 +30,10 @@ fn value(v: Option<f64>, unit: &str) -> String {
 }
 
 fn run_row(r: &RunRow, front: bool) -> Markup {
-    let ms = r.cost_per_step().map_or("—".into(), |s| format!("{:.2}", 1e3 * s));
+    let ms = r.cost.per_step().map_or("—".into(), |s| format!("{:.2}", 1e3 * s));
     html! {
         tr class=(if front { "front" } else { "" }) {
-            td class="l" { code { (r.id) } }
+            td class="l" { code { (r.id) } @if r.reused { " (cached)" } }
             td { (r.dx) }
             td class="l" { (snake(r.variant.ppe)) }
             td class="l" { (format!("{:?}", r.variant.gradient).to_lowercase()) }
@@ -41,7 +41,7 @@ fn run_row(r: &RunRow, front: bool) -> Markup {
             td class="l" { (format!("{:?}", r.variant.shifting).to_lowercase()) }
             td class="l" { (format!("{:?}", r.variant.dt).to_lowercase()) }
             td class="l" { (r.preset.as_deref().unwrap_or("")) }
-            (cost_cells(r.threads, r.particles, r.steps, r.wall_s, r.cpu_s, &ms, r.ppe_iterations_mean))
+            (cost_cells(r.threads, &r.cost, &ms))
             td { (pct(r.b_err)) }
             td { (pct(r.b_err_max)) }
             td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
@@ -51,23 +51,15 @@ fn run_row(r: &RunRow, front: bool) -> Markup {
 
 /// The cells both studies' rows share: threads, particles, steps, wall time \[s\], CPU/wall,
 /// `ms` per step (formatted by the caller) and mean PPE iterations.
-fn cost_cells(
-    threads: usize,
-    particles: usize,
-    steps: usize,
-    wall_s: f64,
-    cpu_s: Option<f64>,
-    ms: &str,
-    ppe_iterations: f64,
-) -> Markup {
+fn cost_cells(threads: usize, c: &Cost, ms: &str) -> Markup {
     html! {
         td { (threads) }
-        td { (particles) }
-        td { (steps) }
-        td { (format!("{wall_s:.3}")) }
-        td { (cpu_s.map_or("—".into(), |c| format!("{:.2}", c / wall_s.max(1e-12)))) }
+        td { (c.particles) }
+        td { (c.steps) }
+        td { (format!("{:.3}", c.wall_s)) }
+        td { (c.cpu_s.map_or("—".into(), |cpu| format!("{:.2}", cpu / c.wall_s.max(1e-12)))) }
         td { (ms) }
-        td { (format!("{ppe_iterations:.1}")) }
+        td { (format!("{:.1}", c.ppe_iterations_mean)) }
     }
 }
 
@@ -77,16 +69,20 @@ fn snake<T: serde::Serialize>(v: T) -> String {
 }
 
 fn channel_row(r: &ChannelRow, front: bool) -> Markup {
-    let ms = if r.steps > 0 { format!("{:.3}", 1e3 * r.wall_s / r.steps as f64) } else { "—".into() };
+    let ms = if r.cost.steps > 0 {
+        format!("{:.3}", 1e3 * r.cost.wall_s / r.cost.steps as f64)
+    } else {
+        "—".into()
+    };
     html! {
         tr class=(if front { "front" } else { "" }) {
-            td class="l" { code { (r.id) } }
+            td class="l" { code { (r.id) } @if r.reused { " (cached)" } }
             td { (format!("{:.5}", r.dx)) }
             td class="l" { (snake(r.variant.viscosity)) }
             td class="l" { (snake(r.variant.shifting)) }
             td class="l" { (snake(r.variant.ppe)) }
             td class="l" { (r.preset.as_deref().unwrap_or("")) }
-            (cost_cells(r.threads, r.particles, r.steps, r.wall_s, r.cpu_s, &ms, r.ppe_iterations_mean))
+            (cost_cells(r.threads, &r.cost, &ms))
             td { (pct(r.error)) }
             td { (pct(r.error_startup_max)) }
             td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
@@ -120,6 +116,8 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
     let front: Vec<&RunRow> =
         study.pareto.iter().filter_map(|id| study.runs.iter().find(|r| &r.id == id)).collect();
     let diverged = study.runs.iter().filter(|r| !r.ok()).count();
+    let reused = study.runs.iter().filter(|r| r.reused).count()
+        + study.channel.iter().flat_map(|c| &c.runs).filter(|r| r.reused).count();
     html! {
         (DOCTYPE)
         html lang="en" {
@@ -136,6 +134,10 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                     (diverged) " diverged), tier " b { (study.tier) } ", " b { (m.build) } " build, " (study.threads) " threads for the main runs; the study took "
                     (format!("{:.0}", study.elapsed_s)) " s (both studies)."
                     @if !study.complete { " " b { "Incomplete: the study was interrupted." } }
+                    @if reused > 0 {
+                        " " b { (reused) " runs (marked cached) were taken from the run cache of an earlier invocation" }
+                        " (" code { "--resume" } "): their times were measured then, under that invocation's load."
+                    }
                     @if study.channel.is_some() { " The periodic channel's study has its own section and figure below." }
                 }
                 h2 { "Targets" }
@@ -167,7 +169,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                 p { "Runs that no other run (" (study.threads) " threads) beats on both wall time and b error, cheapest first." }
                 table {
                     tr { th class="l" { "run" } th { "wall [s]" } th { "b error" } }
-                    @for r in &front { tr { td class="l" { code { (r.id) } } td { (format!("{:.3}", r.wall_s)) } td { (pct(r.b_err)) } } }
+                    @for r in &front { tr { td class="l" { code { (r.id) } } td { (format!("{:.3}", r.cost.wall_s)) } td { (pct(r.b_err)) } } }
                 }
                 h2 { "Cost per step and threads" }
                 table {

@@ -181,7 +181,7 @@ pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<
                 id: &r.id,
                 dx: r.dx,
                 error,
-                wall_s: r.wall_s,
+                wall_s: r.cost.wall_s,
                 label: r.preset.as_ref().map(|name| format!("{name} Δx={}", r.dx)),
             })
         })
@@ -207,7 +207,7 @@ pub fn channel_work_precision(file: &str, runs: &[&ChannelRow], front: &[String]
                 id: &r.id,
                 dx: r.dx,
                 error,
-                wall_s: r.wall_s,
+                wall_s: r.cost.wall_s,
                 label: r.preset.as_ref().map(|name| format!("{name} Δx={}", dx_text(r.dx))),
             })
         })
@@ -225,15 +225,15 @@ pub fn channel_work_precision(file: &str, runs: &[&ChannelRow], front: &[String]
 /// Horizontal stacked bars: microseconds per particle and step spent in each stage, for
 /// each row in `bars` (label, run).
 pub fn stage_breakdown(file: &str, bars: &[(String, &RunRow)]) -> Result<String> {
-    let mut stages: Vec<String> = bars.iter().flat_map(|(_, r)| r.stages.keys().cloned()).collect();
+    let mut stages: Vec<String> = bars.iter().flat_map(|(_, r)| r.cost.stages.keys().cloned()).collect();
     stages.sort();
     stages.dedup();
     // Largest total first in the legend.
-    let total = |s: &str| bars.iter().map(|(_, r)| r.stages.get(s).copied().unwrap_or(0.0)).sum::<f64>();
+    let total = |s: &str| bars.iter().map(|(_, r)| r.cost.stages.get(s).copied().unwrap_or(0.0)).sum::<f64>();
     stages.sort_by(|a, b| total(b).total_cmp(&total(a)));
     let per = |r: &RunRow, s: &str| {
-        let work = (r.particles * r.steps.max(1)) as f64;
-        1e6 * r.stages.get(s).copied().unwrap_or(0.0) / work
+        let work = (r.cost.particles * r.cost.steps.max(1)) as f64;
+        1e6 * r.cost.stages.get(s).copied().unwrap_or(0.0) / work
     };
     let width = bars.iter().map(|(_, r)| stages.iter().map(|s| per(r, s)).sum::<f64>()).fold(0.0, f64::max);
     let n = bars.len().max(1);
@@ -288,11 +288,11 @@ pub fn stage_breakdown(file: &str, bars: &[(String, &RunRow)]) -> Result<String>
 /// as hollow markers.
 pub fn cost_scaling(file: &str, fits: &[CostFit], one_thread: &[&RunRow]) -> Result<String> {
     let all_n = fits.iter().flat_map(|f| f.particles.iter().map(|&p| p as f64));
-    let (x0, x1) = log_range(all_n.chain(one_thread.iter().map(|r| r.particles as f64)), 1.5);
+    let (x0, x1) = log_range(all_n.chain(one_thread.iter().map(|r| r.cost.particles as f64)), 1.5);
     let (y0, y1) = log_range(
         fits.iter()
             .flat_map(|f| f.cost_per_step_s.iter().copied())
-            .chain(one_thread.iter().filter_map(|r| r.cost_per_step())),
+            .chain(one_thread.iter().filter_map(|r| r.cost.per_step())),
         2.0,
     );
     svg(file, |root| {
@@ -328,7 +328,7 @@ pub fn cost_scaling(file: &str, fits: &[CostFit], one_thread: &[&RunRow]) -> Res
             let ones: Vec<(f64, f64)> = one_thread
                 .iter()
                 .filter(|r| r.preset.as_deref() == Some(f.preset.as_str()))
-                .filter_map(|r| r.cost_per_step().map(|s| (r.particles as f64, s)))
+                .filter_map(|r| r.cost.per_step().map(|s| (r.cost.particles as f64, s)))
                 .collect();
             if !ones.is_empty() {
                 chart

@@ -22,6 +22,27 @@ pub struct RunRow {
     pub threads: usize,
     /// Parts of the design that asked for the run.
     pub groups: Vec<String>,
+    /// Size and cost of the run.
+    #[serde(flatten)]
+    pub cost: Cost,
+    /// Relative error of the semi-axis b (second moments) at the end time, t = 0.008 s,
+    /// against the ellipse ODE (`b_rel_err_final`); `None` when the run diverged.
+    pub b_err: Option<f64>,
+    /// Largest relative b error over the history (`b_rel_err_max`).
+    pub b_err_max: Option<f64>,
+    /// Relative error of the semi-axis a at the end time (`a_rel_err_final`).
+    pub a_err: Option<f64>,
+    /// `ok` or `diverged: <cause at stage, step, time>`.
+    pub status: String,
+    /// Taken from the run cache of an earlier invocation (`cargo xtask bench --resume`):
+    /// its times are those measured then. Absent when measured by this one.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub reused: bool,
+}
+
+/// The size and cost of a run, from the solver's summary (a row of either study).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+pub struct Cost {
     /// Particles.
     pub particles: usize,
     /// Steps taken.
@@ -38,26 +59,19 @@ pub struct RunRow {
     pub stages: BTreeMap<String, f64>,
     /// Mean PPE iterations per step.
     pub ppe_iterations_mean: f64,
-    /// Relative error of the semi-axis b (second moments) at the end time, t = 0.008 s,
-    /// against the ellipse ODE (`b_rel_err_final`); `None` when the run diverged.
-    pub b_err: Option<f64>,
-    /// Largest relative b error over the history (`b_rel_err_max`).
-    pub b_err_max: Option<f64>,
-    /// Relative error of the semi-axis a at the end time (`a_rel_err_final`).
-    pub a_err: Option<f64>,
-    /// `ok` or `diverged: <cause at stage, step, time>`.
-    pub status: String,
+}
+
+impl Cost {
+    /// Wall time per step \[s\] (`None` before the first step).
+    pub fn per_step(&self) -> Option<f64> {
+        (self.steps > 0).then(|| self.wall_s / self.steps as f64)
+    }
 }
 
 impl RunRow {
     /// Whether the run reached its end time.
     pub fn ok(&self) -> bool {
         self.status == "ok"
-    }
-
-    /// Wall time per step \[s\] (`None` before the first step).
-    pub fn cost_per_step(&self) -> Option<f64> {
-        (self.steps > 0).then(|| self.wall_s / self.steps as f64)
     }
 
     /// Whether the run is `preset` at `dx` with `threads` threads.

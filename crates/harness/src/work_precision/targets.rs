@@ -27,7 +27,7 @@ pub const PRESETS: [&str; 2] = ["paper", "tuned"];
 fn finished(runs: &[RunRow], threads: usize) -> Vec<(&RunRow, (f64, f64))> {
     runs.iter()
         .filter(|r| r.threads == threads && r.ok())
-        .filter_map(|r| r.b_err.filter(|e| e.is_finite()).map(|e| (r, (e, r.wall_s))))
+        .filter_map(|r| r.b_err.filter(|e| e.is_finite()).map(|e| (r, (e, r.cost.wall_s))))
         .collect()
 }
 
@@ -51,8 +51,8 @@ pub fn cost_fits(runs: &[RunRow], threads: usize) -> Vec<CostFit> {
                 .collect();
             mine.sort_by(|a, b| b.dx.total_cmp(&a.dx));
             mine.dedup_by(|a, b| (a.dx - b.dx).abs() < 1e-12);
-            let particles: Vec<usize> = mine.iter().map(|r| r.particles).collect();
-            let cost: Vec<f64> = mine.iter().filter_map(|r| r.cost_per_step()).collect();
+            let particles: Vec<usize> = mine.iter().map(|r| r.cost.particles).collect();
+            let cost: Vec<f64> = mine.iter().filter_map(|r| r.cost.per_step()).collect();
             let n: Vec<f64> = particles.iter().map(|&p| p as f64).collect();
             let fit = if cost.len() == n.len() { fit_power_law(&n, &cost) } else { None };
             CostFit {
@@ -82,16 +82,16 @@ pub fn speedups(runs: &[RunRow], threads: usize) -> Vec<SpeedUp> {
             let many = runs.iter().find(|r| r.is(preset, dx, threads) && r.ok());
             if let (Some(one), Some(many)) = (one, many)
                 && threads > 1
-                && many.wall_s > 0.0
+                && many.cost.wall_s > 0.0
             {
                 out.push(SpeedUp {
                     preset: preset.to_string(),
                     dx,
-                    particles: many.particles,
+                    particles: many.cost.particles,
                     threads,
-                    wall_1_s: one.wall_s,
-                    wall_n_s: many.wall_s,
-                    speedup: one.wall_s / many.wall_s,
+                    wall_1_s: one.cost.wall_s,
+                    wall_n_s: many.cost.wall_s,
+                    speedup: one.cost.wall_s / many.cost.wall_s,
                 });
             }
         }
@@ -133,12 +133,16 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
     let paper = runs.iter().find(|r| r.is("paper", 0.02, threads));
     out.push(max_target(
         format!("paper preset, Δx = 0.02, wall time with {threads} threads ≤ {PAPER_WALL_S} s"),
-        paper.filter(|r| r.ok()).map(|r| r.wall_s),
+        paper.filter(|r| r.ok()).map(|r| r.cost.wall_s),
         PAPER_WALL_S,
         "s",
         match paper {
             Some(r) if r.ok() => {
-                format!("{} steps, {:.2} ms per step", r.steps, 1e3 * r.wall_s / r.steps as f64)
+                format!(
+                    "{} steps, {:.2} ms per step",
+                    r.cost.steps,
+                    1e3 * r.cost.wall_s / r.cost.steps as f64
+                )
             }
             Some(r) => format!("the run did not finish: {}", r.status),
             None => "not run".into(),
@@ -155,7 +159,7 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
             "fastest run with b error ≤ {} % at t = 0.008 s: wall time ≤ {B_ERR_WALL_S} s",
             B_ERR * 100.0
         ),
-        best.map(|(r, _)| r.wall_s),
+        best.map(|(r, _)| r.cost.wall_s),
         B_ERR_WALL_S,
         "s",
         match best {
@@ -177,18 +181,18 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
                 // the fit would be with that run's cost per step over the steps it took.
                 let missing = if fine > finest_dx + 1e-12 {
                     let stopped = runs.iter().find(|r| r.is(&fit.preset, finest_dx, threads) && !r.ok());
-                    match stopped.and_then(|r| r.cost_per_step().map(|c| (r, c))) {
+                    match stopped.and_then(|r| r.cost.per_step().map(|c| (r, c))) {
                         Some((r, c)) => {
                             let mut n: Vec<f64> = fit.particles.iter().map(|&p| p as f64).collect();
                             let mut cost = fit.cost_per_step_s.clone();
-                            n.push(r.particles as f64);
+                            n.push(r.cost.particles as f64);
                             cost.push(c);
                             let with = fit_power_law(&n, &cost).map_or(String::new(), |f| {
                                 format!("; with its cost per step over them, {:.3}", f.order)
                             });
                             format!(
                                 "; Δx = {finest_dx} did not finish: it stopped after {} steps{with}",
-                                r.steps
+                                r.cost.steps
                             )
                         }
                         None => format!("; Δx = {finest_dx} did not finish"),
@@ -236,6 +240,7 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
 mod tests {
     use super::*;
     use crate::work_precision::design::Variant;
+    use crate::work_precision::record::Cost;
 
     fn row(preset: Option<Variant>, dx: f64, threads: usize, wall_s: f64, b_err: Option<f64>) -> RunRow {
         let variant = preset.unwrap_or(Variant { dt: super::super::design::Dt::Adaptive, ..Variant::PAPER });
@@ -247,17 +252,19 @@ mod tests {
             preset: variant.preset().map(str::to_string),
             threads,
             groups: vec![],
-            particles,
-            steps: 400,
-            t_end: 0.008,
-            wall_s,
-            cpu_s: None,
-            stages: Default::default(),
-            ppe_iterations_mean: 10.0,
+            cost: Cost {
+                particles,
+                steps: 400,
+                t_end: 0.008,
+                wall_s,
+                ppe_iterations_mean: 10.0,
+                ..Cost::default()
+            },
             b_err,
             b_err_max: b_err,
             a_err: b_err,
             status: if b_err.is_some() { "ok".into() } else { "diverged: guard at step 3".into() },
+            reused: false,
         }
     }
 
@@ -319,7 +326,7 @@ mod tests {
             row(p, 0.01, 2, 6.4, Some(0.008)),
         ];
         runs[2].status = "diverged: guard at step 870".into();
-        runs[2].steps = 200;
+        runs[2].cost.steps = 200;
         let ts = evaluate(&runs, 2, 0.01);
         assert!((ts[2].value.unwrap() - 1.0).abs() < 1e-2, "{:?}", ts[2]);
         assert!(
