@@ -19,9 +19,10 @@ pub fn write_frame(dir: &Path, frame: &Frame) -> anyhow::Result<PathBuf> {
 
 /// Writes `frame` to `dir/<stem>.vtu` atomically (temporary file, then rename).
 pub fn write_frame_as(dir: &Path, stem: &str, frame: &Frame) -> anyhow::Result<PathBuf> {
-    // Extra per-particle fields of a frame go into these two lists as (name, values), e.g.
-    // `&frame.extra.iter().map(|(n, v)| (n.as_str(), &v[..])).collect::<Vec<_>>()`.
-    write_vtu(dir, stem, frame, &[], &[])
+    // The scheme's further declared fields (div r, WCSPH's density, ...).
+    let scalars: Vec<(&str, &[f64])> = frame.scalars.iter().map(|(n, v)| (n.as_str(), &v[..])).collect();
+    let vectors: Vec<(&str, &[[f64; 3]])> = frame.vectors.iter().map(|(n, v)| (n.as_str(), &v[..])).collect();
+    write_vtu(dir, stem, frame, &scalars, &vectors)
 }
 
 /// Writes `frame` to `dir/<stem>.vtu` atomically with, after the fixed arrays, the point-data
@@ -132,6 +133,7 @@ mod tests {
             u: (0..n).map(|i| [v(i, 2), v(i, 3), v(i, 4)]).collect(),
             p: (0..n).map(|i| v(i, 5)).collect(),
             free_surface: (0..n).map(|i| i % 3 == 1).collect(),
+            ..Default::default()
         }
     }
 

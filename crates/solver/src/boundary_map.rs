@@ -5,8 +5,6 @@
 //! buffer, an inlet row with no source yet). The PPE assembly and solve, the implicit
 //! viscous solve and the mirror walls read it instead of deciding each for itself.
 
-use crate::state::{InletLink, Mirrors};
-
 /// How a particle's value enters the fluid's implicit systems.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Link {
@@ -46,29 +44,28 @@ impl Default for BoundaryMap {
 
 impl BoundaryMap {
     /// Rebuilds the links of the `total − fluid` boundary particles: the inlet buffer first
-    /// (`inlet.source`: each one's pressure source, `u32::MAX` for none; velocities known),
+    /// (`inlet_sources`: each one's pressure source, `u32::MAX` for none; velocities known),
     /// then the rest of the open-boundary buffers (known) up to `walls_start`, then the
-    /// wall particles: `mirrors` (pressure and signed velocity of their source) followed by
-    /// dummy wall particles (known).
+    /// wall particles: the mirrors (pressure and velocity of particle `mirror_source[k]`,
+    /// the velocity times `mirror_sign[k]`) followed by dummy wall particles (known).
     pub fn rebuild(
         &mut self,
-        fluid: usize,
-        total: usize,
-        walls_start: usize,
-        inlet: &InletLink,
-        mirrors: &Mirrors,
+        (fluid, total, walls_start): (usize, usize, usize),
+        inlet_sources: &[u32],
+        mirror_source: &[u32],
+        mirror_sign: &[f64],
     ) {
         self.start = fluid;
         self.pressure.clear();
         self.velocity.clear();
         for b in fluid..total {
             let (p, u) = if b < walls_start {
-                match inlet.source.get(b - fluid) {
+                match inlet_sources.get(b - fluid) {
                     Some(&src) if src != u32::MAX => (Link::Shares { source: src, sign: 1.0 }, Link::Known),
                     _ => (Link::Known, Link::Known),
                 }
             } else {
-                match (mirrors.source.get(b - walls_start), mirrors.sign.get(b - walls_start)) {
+                match (mirror_source.get(b - walls_start), mirror_sign.get(b - walls_start)) {
                     (Some(&source), Some(&sign)) => {
                         (Link::Shares { source, sign: 1.0 }, Link::Shares { source, sign })
                     }
@@ -124,10 +121,8 @@ mod tests {
     /// outlet buffer) and a dummy particle.
     #[test]
     fn links_of_every_kind_of_boundary_particle() {
-        let inlet = InletLink { columns: 1, row_id: vec![0, 1], source: vec![1, u32::MAX] };
-        let mirrors = Mirrors { source: vec![0, 2, 4], sign: vec![-1.0, -1.0, 1.0] };
         let mut map = BoundaryMap::default();
-        map.rebuild(2, 9, 5, &inlet, &mirrors);
+        map.rebuild((2, 9, 5), &[1, u32::MAX], &[0, 2, 4], &[-1.0, -1.0, 1.0]);
         let shares = |source, sign| Link::Shares { source, sign };
         let p: Vec<Link> = (0..9).map(|b| map.pressure(b)).collect();
         let u: Vec<Link> = (0..9).map(|b| map.velocity(b)).collect();

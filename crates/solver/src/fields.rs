@@ -13,7 +13,10 @@
 //! [`Vectors`]: ColumnRef::Vectors
 //! [`Flags`]: ColumnRef::Flags
 
-use crate::state::Vector;
+use nalgebra::SVector;
+
+/// Vector type of the solver (positions, velocities, …) \[SI units of the field\].
+pub type Vector<const D: usize> = SVector<f64, D>;
 
 /// One per-particle array, read-only.
 #[derive(Debug, Clone, Copy)]
@@ -156,7 +159,7 @@ macro_rules! particle_fields {
     };
     (@type Ids) => { Vec<u32> };
     (@type Scalars) => { Vec<f64> };
-    (@type Vectors) => { Vec<$crate::state::Vector<D>> };
+    (@type Vectors) => { Vec<$crate::fields::Vector<D>> };
     (@type Flags) => { Vec<bool> };
     (@output) => { None };
     (@output $out:literal) => { Some($out) };

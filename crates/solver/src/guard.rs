@@ -197,15 +197,6 @@ impl<const D: usize> GuardBox<D> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::run::Simulation;
-    use crate::stage::StepContext;
-
-    fn small_drop() -> Simulation<2> {
-        let text = include_str!("../../../validation/scenes/elliptical_drop.json");
-        let mut scene = Scene::from_json(text).expect("DESIGN scene");
-        scene.dx = 0.1;
-        Simulation::<2>::new(&scene).expect("builds")
-    }
 
     #[test]
     fn bulk_neighbour_count_of_the_lattice() {
@@ -215,59 +206,5 @@ mod tests {
         // h = Δx: |z|² ∈ {1, 2, 4} in 2D; in 3D |z|² ∈ {1, 2, 3, 4}: 6 + 12 + 8 + 6.
         assert_eq!(NeighbourBand::new::<2>(2.0, 1.0).bulk, 12);
         assert_eq!(NeighbourBand::new::<3>(2.0, 1.0).bulk, 32);
-    }
-
-    /// Runs the neighbour-search stage of a simulation.
-    fn search_neighbours(sim: &mut Simulation<2>, ctx: &StepContext) -> Result<(), Cause> {
-        let m = sim.method_mut();
-        let i = (0..m.stage_count()).find(|&i| m.stage_name(i) == "neighbours").expect("a neighbour stage");
-        m.run_stage(i, ctx)
-    }
-
-    #[test]
-    fn clumped_particles_trip_the_neighbour_guard() {
-        let mut sim = small_drop();
-        let ctx = StepContext { step: 1, time: 0.0, dt: 1e-5 };
-        search_neighbours(&mut sim, &ctx).expect("neighbour search");
-        assert_eq!(sim.guard(0.0, 0.0), Ok(()), "the initial lattice is within the band");
-        // Squeeze the drop to a third of its size: every interior particle now has about
-        // 9 × 28 neighbours.
-        for x in &mut sim.method_mut().state_mut().particles.x {
-            *x /= 3.0;
-        }
-        search_neighbours(&mut sim, &ctx).expect("neighbour search");
-        let cause = sim.guard(0.0, 0.0).expect_err("clumping must trip the guard");
-        let Cause::Clumping { count, limit, bulk, others, .. } = &cause else { panic!("{cause}") };
-        assert!(count > limit && *limit == 112 && *bulk == 28 && *others > 10, "{cause}");
-        let msg = cause.to_string();
-        assert!(msg.contains("neighbours") && msg.contains("clumping"), "{msg}");
-    }
-
-    #[test]
-    fn guard_reports_the_most_severe_failure_with_the_lowest_id() {
-        let mut sim = small_drop();
-        let ctx = StepContext { step: 1, time: 0.0, dt: 1e-5 };
-        search_neighbours(&mut sim, &ctx).expect("neighbour search");
-        let n = sim.state().particles.len();
-        let at =
-            |sim: &Simulation<2>, id: u32| sim.state().particles.id.iter().position(|&i| i == id).unwrap();
-        let (a, b, c) = (at(&sim, 7), at(&sim, 3), at(&sim, (n - 1) as u32));
-        sim.method_mut().state_mut().particles.x[a][0] = 1e6;
-        sim.method_mut().state_mut().particles.x[b][1] = -1e6;
-        sim.method_mut().state_mut().particles.p[c] = f64::NAN;
-        match sim.guard(0.0, 0.0) {
-            Err(Cause::NonFinite { quantity: "pressure", particle, others: 0 }) => {
-                assert_eq!(particle, n - 1)
-            }
-            other => panic!("{other:?}"),
-        }
-        sim.method_mut().state_mut().particles.p[c] = 0.0;
-        let cause = sim.guard(0.0, 0.0).expect_err("escape");
-        assert!(matches!(cause, Cause::Escape { particle: 3, others: 1, .. }), "{cause}");
-        let msg = cause.to_string();
-        assert!(
-            msg.starts_with("particle 3 escaped to (") && msg.contains("(and 1 other particle)"),
-            "{msg}"
-        );
     }
 }

@@ -1,10 +1,7 @@
 //! Particle storage (structure of arrays) and the per-step shared data (pair cache).
 
+pub use crate::fields::Vector;
 use crate::neighbours::{Domain, NeighbourList};
-use nalgebra::SVector;
-
-/// Vector type of the solver.
-pub type Vector<const D: usize> = SVector<f64, D>;
 
 crate::particle_fields! {
     /// Particles, structure of arrays: the `fluid` fluid particles first, then the boundary

@@ -26,7 +26,6 @@ pub mod particle_density;
 pub mod ppe;
 pub mod predictor;
 pub mod projection;
-pub mod shifting;
 
 use crate::error::{Cause, SceneError};
 use crate::fields::{ColumnMut, ColumnRef, Field, Fields};
@@ -42,7 +41,7 @@ use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
 use crate::stages::surface_tension::{Force, SurfaceTension};
 use crate::stages::young_laplace::SurfacePressure;
-use crate::stages::{free_surface::FreeSurface, reorder::Reorder, walls};
+use crate::stages::{free_surface::FreeSurface, reorder::Reorder, shifting, walls};
 use crate::state::{State, Vector};
 use crate::time_step;
 use rayon::prelude::*;

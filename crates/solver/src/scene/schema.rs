@@ -388,7 +388,7 @@ pub struct WcsphOptions {
     #[serde(default)]
     pub continuity: ContinuityForm,
     /// Particle shifting after the second half kick (none if absent): the ISPH stage
-    /// ([`crate::isph::shifting`]), with its free-surface scaling on `div r` against the
+    /// ([`crate::stages::shifting`]), with its free-surface scaling on `div r` against the
     /// threshold `D − ½` (1.5 in 2D, Qiu eq. 16 as corrected).
     #[serde(default)]
     pub shifting: Shifting,

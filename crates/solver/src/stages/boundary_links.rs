@@ -16,8 +16,8 @@ impl<const D: usize, O> Stage<D, O> for BoundaryLinks {
     }
 
     fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
-        let (fluid, total, walls_start) = (s.particles.fluid, s.particles.total(), s.walls_start());
-        s.links.rebuild(fluid, total, walls_start, &s.inlet, &s.mirrors);
+        let layout = (s.particles.fluid, s.particles.total(), s.walls_start());
+        s.links.rebuild(layout, &s.inlet.source, &s.mirrors.source, &s.mirrors.sign);
         Ok(())
     }
 }

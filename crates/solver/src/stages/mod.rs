@@ -8,6 +8,7 @@ pub mod free_surface;
 pub mod neighbours;
 pub mod open_boundary;
 pub mod reorder;
+pub mod shifting;
 pub mod surface_tension;
 pub mod walls;
 pub mod young_laplace;

@@ -20,7 +20,6 @@ pub mod forces;
 pub mod integrator;
 
 use crate::error::{Cause, SceneError};
-use crate::isph::shifting::Law;
 use crate::kernel::{Kernel, Scaled};
 use crate::scene::{Scene, Scheme as SceneScheme, WallModel, WcsphOptions};
 use crate::scheme::{Adaptive, Composed, Scheme};
@@ -28,6 +27,7 @@ use crate::stage::{Stage, StepContext};
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::free_surface::FreeSurface;
 use crate::stages::neighbours::{Neighbours, Rows};
+use crate::stages::shifting::Law;
 use crate::stages::surface_tension::{Force, SurfaceTension};
 use crate::stages::{reorder::Reorder, walls};
 use crate::state::{State, Vector};
@@ -190,7 +190,7 @@ fn build_stages<K: Kernel, const D: usize>(
         // particle).
         let threshold = D as f64 - 0.5;
         stages.push(Box::new(FreeSurface { threshold }));
-        stages.push(Box::new(crate::isph::shifting::Shifting::new(law, kernel, threshold)));
+        stages.push(Box::new(crate::stages::shifting::Shifting::new(law, kernel, threshold)));
     }
     stages
 }
