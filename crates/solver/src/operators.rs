@@ -2,7 +2,10 @@
 //! from the pair cache ([`Pair`]): the Shao–Lo Laplacian's pair coefficient with its
 //! regularisation ([`ShaoLo`]), the velocity divergence in its difference and
 //! kernel-corrected forms ([`divergence`], [`corrected_divergence`]), and the moment
-//! matrix of the kernel-gradient correction ([`moment`]).
+//! matrix of the kernel-gradient correction ([`moment`]), which the `moments` stage
+//! inverts once per step for every stage that corrects a gradient
+//! ([`crate::stages::moments`]: the corrected divergence, the corrected pressure gradient,
+//! the shifting's Taylor correction).
 //!
 //! Each function evaluates its formula in one fixed order of operations, the order the
 //! stages used before it was shared, so that moving a stage onto it changes no bit.
@@ -63,39 +66,48 @@ pub fn divergence<const D: usize>(
     volume * div
 }
 
+/// A D × D matrix.
+pub type Matrix<const D: usize> = SMatrix<f64, D, D>;
+
+/// The velocity gradient sum `G_a = Σ_b (u_b − u_a) ⊗ ∇_aW_ab` (without the volume).
+#[inline]
+pub fn velocity_gradient_sum<const D: usize>(u: &[Vector<D>], a: usize, pairs: &[Pair<D>], nbrs: &[u32]) -> Matrix<D> {
+    let mut g = Matrix::<D>::zeros();
+    for (p, &b) in pairs.iter().zip(nbrs) {
+        g += (u[b as usize] - u[a]) * (p.r_ab * p.f).transpose();
+    }
+    g
+}
+
 /// The kernel-gradient corrected divergence (Bonet & Lok 1999): `tr(G_a M_a⁻¹)` with
-/// `G_a = Σ_b (u_b − u_a) ⊗ ∇_aW_ab` and the [`moment`] matrix; exact for linear velocity
-/// fields on any arrangement, a free surface included. Where `M_a` is singular (an
-/// isolated particle) it falls back to `V tr G_a`, the difference form.
+/// [`velocity_gradient_sum`] `G_a` and the inverse `m_inv` of the [`moment`] matrix; exact
+/// for linear velocity fields on any arrangement, a free surface included. Where `M_a` is
+/// singular (`None`: an isolated particle) it falls back to `V tr G_a`, the difference
+/// form.
 #[inline]
 pub fn corrected_divergence<const D: usize>(
     u: &[Vector<D>],
     a: usize,
-    pairs: &[Pair<D>],
-    nbrs: &[u32],
+    (pairs, nbrs): (&[Pair<D>], &[u32]),
     volume: f64,
+    m_inv: Option<&Matrix<D>>,
 ) -> f64 {
-    let mut g = SMatrix::<f64, D, D>::zeros();
-    let mut m = SMatrix::<f64, D, D>::zeros();
-    for (p, &b) in pairs.iter().zip(nbrs) {
-        let grad = p.r_ab * p.f;
-        g += (u[b as usize] - u[a]) * grad.transpose();
-        m -= p.r_ab * grad.transpose();
-    }
-    match m.try_inverse() {
+    let g = velocity_gradient_sum(u, a, pairs, nbrs);
+    match m_inv {
         Some(mi) => (g * mi).trace(),
         None => volume * g.trace(),
     }
 }
 
 /// The moment matrix of the kernel-gradient correction (Bonet & Lok 1999 eq. 43, without
-/// the volume), `M_a = Σ_b (r_b − r_a) ⊗ ∇_aW_ab = −Σ_b f r_ab ⊗ r_ab` (symmetric; ≈ I/V in
+/// the volume), `M_a = Σ_b (r_b − r_a) ⊗ ∇_aW_ab = −Σ_b r_ab ⊗ f r_ab` (symmetric; ≈ I/V in
 /// the bulk of a lattice); a corrected gradient is `M_a⁻¹ Σ_b (φ_b ∓ φ_a) ∇_aW_ab`.
 #[inline]
-pub fn moment<const D: usize>(pairs: &[Pair<D>]) -> SMatrix<f64, D, D> {
-    let mut m = SMatrix::<f64, D, D>::zeros();
-    for pr in pairs {
-        m -= pr.r_ab * pr.r_ab.transpose() * pr.f;
+pub fn moment<const D: usize>(pairs: &[Pair<D>]) -> Matrix<D> {
+    let mut m = Matrix::<D>::zeros();
+    for p in pairs {
+        let grad = p.r_ab * p.f;
+        m -= p.r_ab * grad.transpose();
     }
     m
 }

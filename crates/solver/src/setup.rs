@@ -61,6 +61,7 @@ pub fn particle_state<const D: usize>(scene: &Scene, h: f64, support: f64) -> (S
         flux: Default::default(),
         inlet: open.as_ref().map(|o| o.link.clone()).unwrap_or_default(),
         links: Default::default(),
+        moments: Vec::new(),
         solve: Default::default(),
     };
     (state, open)

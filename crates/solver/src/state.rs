@@ -112,6 +112,10 @@ pub struct State<const D: usize> {
     /// What each boundary particle's pressure and velocity are to the implicit systems
     /// (rebuilt every step by the `boundary_links` stage of a scene with boundaries).
     pub links: crate::boundary_map::BoundaryMap,
+    /// `M_a⁻¹` of the kernel-gradient correction for every fluid particle (`None` where
+    /// `M_a` is singular), from this step's pairs: filled by the `moments` stage of a
+    /// scheme that corrects a gradient, empty otherwise ([`crate::operators::moment`]).
+    pub moments: Vec<Option<crate::operators::Matrix<D>>>,
     /// Iterations and residual of the step's pressure solve (none for explicit schemes).
     pub solve: crate::linalg::SolveInfo,
 }

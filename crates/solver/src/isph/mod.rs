@@ -2,7 +2,9 @@
 //!
 //! The step, built from the scene (a stage the scene does not need is not built):
 //! `reorder` (locality) → `advect` (eq. 3) → `walls` (§2.4.2; mirror walls only) →
-//! `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation) →
+//! `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation) → `moments`
+//! (kernel-gradient correction matrices; with a corrected divergence or gradient, or
+//! shifting) →
 //! `inlet_sources` (inflow only) → `boundary_links` (walls or open boundaries: the
 //! boundary map) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
 //! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) or `surface_pressure`
@@ -31,12 +33,13 @@ use crate::error::{Cause, SceneError};
 use crate::fields::{ColumnMut, ColumnRef, Field, Fields};
 use crate::kernel::{Kernel, Scaled};
 use crate::linalg::LinearSolver;
-use crate::scene::{IsphOptions, Probe, Scene, Scheme as SceneScheme};
+use crate::scene::{Divergence, IsphOptions, PressureGradient, Probe, Scene, Scheme as SceneScheme};
 use crate::scene::{ViscousIntegration, ViscousOperator, WallModel};
 use crate::scheme::{Adaptive, Composed, Scheme};
 use crate::stage::{Stage, StepContext};
 use crate::stages::boundary_links::BoundaryLinks;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
+use crate::stages::moments::Moments;
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
 use crate::stages::surface_tension::{Force, SurfaceTension};
@@ -151,6 +154,14 @@ fn build_stages<K: Kernel, const D: usize>(
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Start)));
     }
+    // The kernel-gradient correction's matrices, once for every stage that reads them.
+    let shifting = shifting::Law::of(opts.shifting);
+    if opts.divergence == Divergence::Corrected
+        || opts.pressure_gradient == PressureGradient::Corrected
+        || shifting.is_some()
+    {
+        stages.push(Box::new(Moments));
+    }
     if open.is_some() {
         stages.push(Box::new(InletSources));
     }
@@ -215,7 +226,7 @@ fn build_stages<K: Kernel, const D: usize>(
     }
     stages.push(Box::new(projection::Correction { form: opts.pressure_gradient }));
     stages.push(Box::new(projection::Position));
-    if let Some(law) = shifting::Law::of(opts.shifting) {
+    if let Some(law) = shifting {
         stages.push(Box::new(shifting::Shifting::new(law, kernel, opts.free_surface_threshold)));
     }
     if let Some(o) = open {

@@ -5,7 +5,7 @@ use super::IsphData;
 use crate::boundary_map::Link;
 use crate::error::Cause;
 use crate::linalg::{LinearSolver, par_csr_rows_mut, stored};
-use crate::operators::{ShaoLo, corrected_divergence, divergence, moment};
+use crate::operators::{ShaoLo, corrected_divergence, divergence};
 use crate::scene::{Divergence, PressureGradient};
 use crate::stage::{Stage, StepContext};
 use crate::state::{State, Vector};
@@ -93,7 +93,7 @@ impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
         }
         m.resize_entries();
         let (v, rho, shao_lo) = (s.volume, s.density, ShaoLo::new(s.h));
-        let pairs = &s.pairs;
+        let (pairs, moments) = (&s.pairs, &s.moments);
         let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
         self.dt_max = self.dt_max.max(ctx.dt);
         let (p, density, relaxation, dt_max) =
@@ -123,7 +123,7 @@ impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
             }
             let (row_pairs, nbrs) = (&pairs[lo..hi], &list.indices[lo..hi]);
             let div = if corrected {
-                corrected_divergence(u, a, row_pairs, nbrs, v)
+                corrected_divergence(u, a, (row_pairs, nbrs), v, moments[a].as_ref())
             } else {
                 divergence(u, a, row_pairs, nbrs, v)
             };
@@ -231,7 +231,7 @@ impl<const D: usize, O> Stage<D, O> for Correction {
     }
 
     fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
-        let (list, pairs, p) = (&s.neighbours, &s.pairs, &s.particles.p);
+        let (list, pairs, p, moments) = (&s.neighbours, &s.pairs, &s.particles.p, &s.moments);
         let c = ctx.dt * s.volume / s.density;
         let sign = match self.form {
             PressureGradient::Symmetric => 1.0,
@@ -246,8 +246,8 @@ impl<const D: usize, O> Stage<D, O> for Correction {
                 g += pr.r_ab * (pr.f * (p[b as usize] + sign * p[a]));
             }
             if corrected {
-                // ∇p_a = (V M)⁻¹ (V g) with the moment matrix M (symmetric).
-                if let Some(mi) = moment(&pairs[lo..hi]).try_inverse() {
+                // ∇p_a = (V M)⁻¹ (V g) with the step's moment matrix M (symmetric).
+                if let Some(mi) = &moments[a] {
                     *u -= mi * g * dt_rho;
                     return;
                 }

@@ -96,7 +96,7 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
         self.du.resize(n, Vector::zeros());
         let u_max = s.max_speed();
         let (k, law, dt, v, dom) = (self.kernel, self.law, ctx.dt, s.volume, s.domain);
-        let (u, list, pairs) = (&s.particles.u, &s.neighbours, &s.pairs);
+        let (u, list, pairs, moments) = (&s.particles.u, &s.neighbours, &s.pairs, &s.moments);
         let (div_r, threshold, cap) = (&s.particles.div_r, self.threshold, MAX_SHIFT * s.dx);
         let (xu, smooth) = match law {
             Law::Xu { smooth, .. } => (true, smooth),
@@ -107,7 +107,6 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
             |(a, (shift, du))| {
                 let mut grad_c = Vector::<D>::zeros();
                 let mut g = SMatrix::<f64, D, D>::zeros();
-                let mut m = SMatrix::<f64, D, D>::zeros();
                 let mut xu_sum = Vector::<D>::zeros();
                 let mut r_sum = 0.0;
                 let mut w_sum = 0.0;
@@ -117,10 +116,10 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
                     if r2 == 0.0 {
                         continue;
                     }
-                    let grad = p.r_ab * (v * p.f);
-                    grad_c += grad;
-                    g += (u[b as usize] - u[a]) * grad.transpose();
-                    m -= p.r_ab * grad.transpose();
+                    // V ∇W for the concentration gradient; ∇W for the velocity gradient sum
+                    // (corrected by the step's moment matrix below).
+                    grad_c += p.r_ab * (v * p.f);
+                    g += (u[b as usize] - u[a]) * (p.r_ab * p.f).transpose();
                     if xu {
                         // n_ab / r_ab² (r̄² applied after the loop).
                         let r = r2.sqrt();
@@ -151,10 +150,11 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
                 if len > cap {
                     d *= cap / len;
                 }
-                // M ≈ I in the bulk; fall back to G where M is near singular (few neighbours).
-                let grad_u = match m.try_inverse() {
-                    Some(mi) if mi.norm() < 10.0 => g * mi,
-                    _ => g,
+                // V M ≈ I in the bulk; fall back to V G where M is near singular (few
+                // neighbours: |(V M)⁻¹| ≥ 10).
+                let grad_u = match &moments[a] {
+                    Some(mi) if mi.norm() < 10.0 * v => g * mi,
+                    _ => g * v,
                 };
                 *shift = d;
                 *du = grad_u * d;
