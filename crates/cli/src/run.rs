@@ -48,15 +48,16 @@ pub fn run(
     threads: Option<usize>,
     max_steps: Option<usize>,
 ) -> anyhow::Result<()> {
-    let mut scene = Scene::from_path(scene_path)?;
-    if let Some(n) = vtk_every {
-        scene.output.vtk_every = n;
-    }
+    // The pool first: validating the scene already runs parallel loops.
     if let Some(n) = threads {
         if n == 0 {
             return Err(UsageError("--threads must be at least 1".into()).into());
         }
         rayon::ThreadPoolBuilder::new().num_threads(n).build_global().context("starting the thread pool")?;
+    }
+    let mut scene = Scene::from_path(scene_path)?;
+    if let Some(n) = vtk_every {
+        scene.output.vtk_every = n;
     }
     writable_dir(out)?;
     let frames = (scene.output.vtk_every > 0).then(|| out.join("frames"));

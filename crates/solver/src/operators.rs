@@ -71,7 +71,12 @@ pub type Matrix<const D: usize> = SMatrix<f64, D, D>;
 
 /// The velocity gradient sum `G_a = Σ_b (u_b − u_a) ⊗ ∇_aW_ab` (without the volume).
 #[inline]
-pub fn velocity_gradient_sum<const D: usize>(u: &[Vector<D>], a: usize, pairs: &[Pair<D>], nbrs: &[u32]) -> Matrix<D> {
+pub fn velocity_gradient_sum<const D: usize>(
+    u: &[Vector<D>],
+    a: usize,
+    pairs: &[Pair<D>],
+    nbrs: &[u32],
+) -> Matrix<D> {
     let mut g = Matrix::<D>::zeros();
     for (p, &b) in pairs.iter().zip(nbrs) {
         g += (u[b as usize] - u[a]) * (p.r_ab * p.f).transpose();

@@ -2,11 +2,10 @@
 //! step's ~60 parallel loops starts on threads that are already polling for work.
 //!
 //! Why: a rayon worker that finds no work for a few tens of microseconds goes to sleep on a
-//! futex, and waking it takes 12–15 µs on this VM. A step alternates parallel loops with
-//! short serial parts (prefix sums, counting sorts, scalar recurrences of the Krylov
-//! solvers), so with two threads most loops paid that wake-up. Measured with a 7860-entry
-//! vector pass on 2 threads: 2.8 µs back to back, 5 µs after 20 µs of serial work, 12–15 µs
-//! after 100 µs or more; with the workers kept polling, 2.5–3.2 µs after any gap.
+//! futex, and waking it costs more than a short parallel loop. A step alternates parallel
+//! loops with short serial parts (prefix sums, counting sorts, scalar recurrences of the
+//! Krylov solvers), so with two threads most loops paid that wake-up
+//! (docs/notes/performance.md).
 //!
 //! This is what OpenMP runtimes do by default (active waiting for a while before
 //! sleeping). The cost is CPU time, not wall time: while the stepping thread works alone,

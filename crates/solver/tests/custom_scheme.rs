@@ -34,7 +34,8 @@ impl<const D: usize> Scheme<D> for Wrapped {
 fn a_wrapped_scheme_runs_through_the_driver_as_the_scheme_it_wraps() {
     let scene = common::drop_scene(|v| {
         v["dx"] = json!(0.05);
-        v["scheme"] = json!({"wcsph": {"sound_speed": 1000.0, "artificial_viscosity": {"alpha": 0.1, "beta": 0.0}}});
+        v["scheme"] =
+            json!({"wcsph": {"sound_speed": 1000.0, "artificial_viscosity": {"alpha": 0.1, "beta": 0.0}}});
         v["time"] = json!({"end": 2e-4, "step": {"adaptive": {"cfl": 0.25, "viscous": 0.125, "max": 1e-4}}});
     });
     let reference = meniscus::run(&scene, &mut Quiet).expect("the scene builds");

@@ -41,7 +41,7 @@ fn corrected_divergence_recovers_the_drop_pressure_and_converges() {
 #[test]
 fn standard_divergence_bias_is_documented() {
     // Qiu eq. 10 on the deformed lattice: a dx-independent bias of about −26 % (see
-    // ARCHITECTURE.md). If this changes, the documentation must change with it.
+    // docs/notes/divergence-operator.md). If this changes, the note must change with it.
     let e = first_solve_error(0.04, "standard");
     assert!((-0.35..-0.15).contains(&e), "{e}");
 }

@@ -66,12 +66,12 @@ fn bit_sensitivity(shifting: serde_json::Value) -> f64 {
 
 #[test]
 fn smooth_xu_shifting_does_not_amplify_bit_level_changes() {
-    // Measured 2.3e-13 (ARCHITECTURE.md, "Xu shifting is discontinuous at the support").
+    // Measured 2.3e-13 (docs/notes/shifting.md, "Xu shifting is discontinuous at the support").
     let smooth = bit_sensitivity(json!({"xu": {"coefficient": 0.02, "smooth": true}}));
     assert!(smooth < 1e-10, "smooth Xu: {smooth:.2e}");
     // As published the shift jumps when a pair crosses the support, and the lattice has
     // pairs exactly on it (3 Δx = 2h): 6.6e-6 measured. If this fails, the published law
-    // changed, and ARCHITECTURE.md must change with it.
+    // changed, and docs/notes/shifting.md must change with it.
     let published = bit_sensitivity(json!({"xu": {"coefficient": 0.02}}));
     assert!(published > 1e-8, "published Xu: {published:.2e}");
 }

@@ -10,12 +10,8 @@ use rayon::prelude::*;
 /// rows with `f32` values, and the inverse diagonal (Jacobi).
 ///
 /// Why `f32` off-diagonals: the matrix products are bound by memory traffic once the
-/// matrix outgrows the cache (the drop at Δx = 0.005, 125 676 rows of ~28 entries: 43 MB
-/// at 12 bytes per entry against a 32 MB L3); at 8 bytes per entry one BiCGSTAB iteration
-/// there took 3.77 instead of 4.43 ms (2 threads, tuned preset, alternating runs of 100
-/// steps, whose trajectories parted: 17.2 against 15.7 iterations per step), and 0.174
-/// instead of 0.196 ms at Δx = 0.02 (7860 rows; full runs, 11.32 against 11.33 iterations
-/// per step). The assemblies round each pair coefficient to `f32` *before* using it, for the off-diagonal
+/// matrix outgrows the cache, and 8 bytes per entry instead of 12 make an iteration
+/// faster (measured: docs/notes/ppe-solvers.md). The assemblies round each pair coefficient to `f32` *before* using it, for the off-diagonal
 /// entry and in the diagonal sum alike, so the stored matrix is exactly a Laplacian whose pair
 /// coefficients moved by ≤ 6e-8 relative (far below the discretisation error), its rows
 /// still sum to zero where the Laplacian's do, and it is still symmetric where the
@@ -55,8 +51,8 @@ impl CsrMatrix {
     /// count).
     ///
     /// One running sum chains every addition to the previous one (its latency, not the
-    /// loads, then sets the pace); four independent sums overlap them. Measured on the drop
-    /// at Δx = 0.02, one thread: 0.484 → 0.435 ms per BiCGSTAB iteration (−10 %).
+    /// loads, then sets the pace); four independent sums overlap them
+    /// (docs/notes/ppe-solvers.md).
     #[inline]
     pub fn row_dot(&self, i: usize, x: &[f64]) -> f64 {
         let (s, e) = (self.row_ptr[i], self.row_ptr[i + 1]);

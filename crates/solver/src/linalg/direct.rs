@@ -9,10 +9,9 @@ use faer::sparse::{SparseColMat, Triplet};
 /// faer's sparse LU of `m`, with faer's global parallelism set to sequential first.
 ///
 /// Why: faer parallelises by default (rayon over every thread of the current pool), and
-/// one direct-solver run left every later two-thread run in the same process about 40 %
-/// slower (the drop at Δx = 0.02: 2.04 s before, 2.88 s after; sequential: 2.17 s after),
-/// which skewed every timing of `cargo xtask bench` taken after its sparse-LU runs. The
-/// solver's own loops are its only parallel work.
+/// one direct-solver run slowed every later two-thread run in the same process, skewing
+/// the timings of `cargo xtask bench` (docs/notes/ppe-solvers.md). The solver's own loops
+/// are its only parallel work.
 pub fn sparse_lu(m: &SparseColMat<usize, f64>) -> Result<Lu<usize, f64>, LuError> {
     faer::set_global_parallelism(faer::Par::Seq);
     m.sp_lu()

@@ -14,10 +14,10 @@
 //! also splits each block's rows among the threads), and the work of an
 //! iteration is fused into as few passes as the recurrence allows: a matrix product with
 //! the dot product that follows it, a vector update with its norm, and with a diagonal
-//! (Jacobi) preconditioner also with the preconditioner's application. On the 7860-row
-//! drop system a vector is 63 kB (cache resident) and a pass costs less than the fork-join
-//! that starts it, so the number of passes, not the arithmetic, sets the time: BiCGSTAB
-//! takes 5 passes per iteration instead of 10, CG 3 instead of 6. The fused passes do the
+//! (Jacobi) preconditioner also with the preconditioner's application. On cache-resident
+//! vectors a pass costs less than the fork-join that starts it, so the number of passes,
+//! not the arithmetic, sets the time: BiCGSTAB takes 5 passes per iteration instead of
+//! 10, CG 3 instead of 6 (docs/notes/ppe-solvers.md). The fused passes do the
 //! same arithmetic in the same order as the separate ones, so the iterates are the same
 //! bits.
 //!
@@ -191,10 +191,9 @@ fn update_preconditioned(
 }
 
 /// `y[i] = h(i, (A x)_i)`, returning `(Σ g₀, Σ g₁)` of `g(i, y[i])` summed block by block
-/// (one pass). The product is split finer than a block: a block is a quarter of the
-/// drop's system at Δx = 0.02, and with two threads whole blocks as tasks often left one
-/// thread three of the four (the solve measured 1.5 times slower than row-parallel); each
-/// block then sums its rows in order, so the sums are still the same bits.
+/// (one pass). The product is split finer than a block, so that few blocks still share
+/// out evenly among the threads (docs/notes/ppe-solvers.md); each block then sums its rows
+/// in order, so the sums are still the same bits.
 fn mul_reduce(
     a: &impl RowOperator,
     x: &[f64],

@@ -50,7 +50,7 @@ impl LinearSolver {
     }
 
     /// Whether to measure the true residual after each solve: one more matrix product and
-    /// a pass, 4–5 % of a BiCGSTAB solve of the drop at Δx = 0.02. The run driver asks for
+    /// a pass (a few % of a solve). The run driver asks for
     /// it only in scenes with a `solver` probe, the one reader of [`SolveInfo::residual`].
     pub fn measuring_residual(mut self, on: bool) -> Self {
         self.measure_residual = on;

@@ -3,10 +3,8 @@
 //! Brezina 1996; Toselli & Widlund 2005 ch. 2), `M⁻¹ = D⁻¹ + P A_c⁻¹ Pᵀ`, `A_c = Pᵀ A P`.
 //!
 //! Why: Jacobi leaves the smooth pressure modes to the Krylov solver, and their number of
-//! iterations grows with the domain's size in particle spacings. A 15 D channel at D/36
-//! (540 spacings long, one Dirichlet end) took 443 BiCGSTAB iterations per step; the
-//! coarse space removes the smooth modes. On the elliptical drop at Δx = 0.02, CG takes
-//! 6.2 iterations per step with it against 23 with Jacobi.
+//! iterations grows with the domain's size in particle spacings; the coarse space removes
+//! the smooth modes (iterations measured: docs/notes/ppe-solvers.md).
 //!
 //! Aggregates are built from the matrix graph (no geometry): rows are visited in order,
 //! and an unassigned row starts an aggregate with its unassigned neighbours, so an
@@ -14,19 +12,16 @@
 //! aggregates; `A_c` is assembled row by row with a sparse accumulator and factorised by
 //! faer's sparse Cholesky when it is symmetric (to rounding) and positive definite, which
 //! it is when `A` is (free-surface, closed and periodic systems, mirror walls), and by
-//! faer's sparse LU otherwise. The open channel's `A` is not symmetric (an inlet buffer
+//! faer's sparse LU otherwise: the open channel's `A` is not symmetric (an inlet buffer
 //! particle shares the unknown of a fluid particle, a one-way link), and a Cholesky
-//! factor of the lower triangle of its `A_c` failed at 64 of 78 rebuilds (Re 400, D/36),
-//! leaving Jacobi: 47.6 BiCGSTAB iterations per step instead of 20 (measured, 2026-12-04).
+//! factor of its `A_c` fails.
 //!
 //! **The coarse space outlives a solve** ([`CoarseSpace`]): building it (aggregation,
-//! assembly, the symbolic and numeric factorisation) costs several Krylov iterations, and
-//! rebuilt for every solve it made the drop's solve twice as slow as Jacobi's although the
-//! iterations fell 3.7-fold. Given a stable key per row (the particle id), the aggregates
-//! follow the particles, and the factor of the last rebuild serves the next `refresh`
-//! solves: particles move little relative to their neighbours in a step, so a factor a few
-//! steps old is still a good coarse solve (drop at Δx = 0.02, CG: 6.26 iterations per step
-//! with a rebuild every 25 solves against 6.20 with one every solve, measured). Where it
+//! assembly, the symbolic and numeric factorisation) costs several Krylov iterations.
+//! Given a stable key per row (the particle id), the aggregates follow the particles, and
+//! the factor of the last rebuild serves the next `refresh` solves: particles move little
+//! relative to their neighbours in a step, so a factor a few steps old is still a good
+//! coarse solve (docs/notes/ppe-solvers.md). Where it
 //! ages faster (the open channel, whose particles enter, leave and shear), a solve that
 //! takes over twice the iterations of the first one after the rebuild brings the next
 //! rebuild forward ([`CoarseSpace::record`]). A row whose
@@ -72,15 +67,10 @@ const ASYMMETRY: f64 = 1e-10;
 /// Whether a solve of `iterations` shows the kept coarse space has degraded against the
 /// `fresh` iterations of the first solve after its rebuild: more than 2 × fresh + 4.
 ///
-/// Why: how fast a kept factor ages depends on the flow. On the elliptical drop a factor
-/// 25 solves old costs nothing (6.26 CG iterations per step against 6.20 rebuilding every
-/// solve; 6.26 with this rule, which its iteration spikes of 5 → 10 right after a rebuild
-/// do not trip, where a 1.5 × fresh + 2 rule did). In the open channel particles enter,
-/// leave and shear past each other, and two or three solves after a rebuild the
-/// iterations jump from ~12 to ~30: BiCGSTAB took 11.9 / 14.7 / 22.9 / 44.7 iterations per
-/// step with a rebuild every 1 / 2 / 5 / 25 solves, and 18.9 with this rule on the
-/// default 25 (Re 400, D/36, to 300 s; at Δx = 0.004 to 100 s 12.5 / 13.7 / 18.0 / 29.9
-/// and 20.2; measured 2026-12-05).
+/// Why: how fast a kept factor ages depends on the flow: on the elliptical drop a factor
+/// 25 solves old costs nothing (its iteration spikes right after a rebuild must not trip
+/// the rule), in the open channel particles enter, leave and shear past each other and the
+/// iterations jump two or three solves after a rebuild (docs/notes/ppe-solvers.md).
 fn degraded(iterations: usize, fresh: usize) -> bool {
     iterations > 2 * fresh + 4
 }

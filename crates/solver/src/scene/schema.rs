@@ -584,7 +584,7 @@ pub enum Shifting {
         /// As published, the shift jumps whenever a neighbour crosses the kernel support
         /// (a 1/r² term appears, and r̄ averages over one more pair), and a bit-level change
         /// of the positions then moves a periodic channel by 1e-3 of u_max at Re = 400
-        /// (ARCHITECTURE.md, "Xu shifting is discontinuous at the support").
+        /// (docs/notes/shifting.md, "Xu shifting is discontinuous at the support").
         #[serde(default, skip_serializing_if = "std::ops::Not::not")]
         smooth: bool,
     },
@@ -667,7 +667,7 @@ pub enum Probe {
     /// solve's `iterations` and relative residual `residual` (‖b − A p‖ / ‖b‖), and `p_max`,
     /// the largest |p| over the fluid \[Pa\]. A projection that turns unstable shows here
     /// first: p_max growing several times per step with the iterations while the flow is
-    /// still smooth (ARCHITECTURE.md, the paper drop preset at Δx = 0.005).
+    /// still smooth (docs/notes/paper-preset-divergence-dx0005.md).
     Solver {},
     /// Mass balance of an open channel (`boundaries.inflow`): the fluid mass in the domain
     /// `mass` and the cumulative masses that entered, `inflow`, and left, `outflow`

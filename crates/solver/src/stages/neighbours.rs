@@ -34,9 +34,8 @@ impl<K: Kernel, const D: usize> Neighbours<K, D> {
         Self { search: CellSearch::new(kernel.support, domain), kernel, rows, div_r: false }
     }
 
-    /// Also sums `div r_a = −Σ_b V_b r_ab · ∇_a W_ab` into `State::div_r` (one pass over
-    /// the pairs fewer than a separate sum: 0.19 of 4.9 ms per step on the drop at
-    /// Δx = 0.02, 2 threads).
+    /// Also sums `div r_a = −Σ_b V_b r_ab · ∇_a W_ab` into `Particles::div_r` (one pass
+    /// over the pairs fewer than a separate sum; docs/notes/performance.md).
     pub fn summing_div_r(mut self) -> Self {
         self.div_r = true;
         self

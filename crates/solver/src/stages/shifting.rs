@@ -14,7 +14,7 @@
 //! p = 0 condition, are not shifted, the rows below them partly, the bulk in full. Removing
 //! only the normal component on surface particles (Lind et al. 2012) was measured too: the
 //! first interior rows were then still pushed into the surface layer and the drop's centre
-//! pressure at Δx = 0.02 ended 12 % off instead of 4 % (ARCHITECTURE.md).
+//! pressure at Δx = 0.02 ended 12 % off instead of 4 % (docs/notes/shifting.md).
 //!
 //! Cap: a shift longer than [`MAX_SHIFT`] Δx is shortened to it. Xu's `1/r²` sum grows
 //! without bound when two particles come close, and where particles are squeezed (the
@@ -66,8 +66,8 @@ impl Law {
 
 /// The shifting stage. It runs after the position update and reuses the step's pair
 /// geometry from r*: the particles have moved by `Δt (uⁿ⁺¹ − uⁿ)/2` since, about 1e-5 Δx
-/// in the drop, far below what the shift's heuristic resolves; recomputing the geometry
-/// made the stage 2.7 times slower (2.52 against 0.93 ms per step, drop at Δx = 0.02).
+/// in the drop, far below what the shift's heuristic resolves, and recomputing the
+/// geometry would cost a pair pass (docs/notes/performance.md).
 #[derive(Debug)]
 pub struct Shifting<K: Kernel, const D: usize> {
     law: Law,
