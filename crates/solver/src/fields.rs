@@ -306,6 +306,33 @@ fn next(k: &mut usize) -> usize {
     *k - 1
 }
 
+/// Test helper (also for the schemes' own declarations): fills every array of `fields`
+/// by index, applies a permutation and panics, naming the field, if an array did not move
+/// with it.
+#[cfg(test)]
+pub(crate) fn check_permutes_every_field<const D: usize>(fields: &mut impl Fields<D>) {
+    let n = 7;
+    fields.visit_mut(&mut |field| match field.column {
+        ColumnMut::Ids(v) => *v = (0..n as u32).collect(),
+        ColumnMut::Scalars(v) => *v = (0..n).map(|i| i as f64).collect(),
+        ColumnMut::Vectors(v) => *v = (0..n).map(|i| Vector::<D>::repeat(i as f64)).collect(),
+        ColumnMut::Flags(v) => *v = (0..n).map(|i| i % 2 == 0).collect(),
+    });
+    let perm: Vec<u32> = vec![3, 0, 6, 1, 5, 2, 4];
+    permute(fields, &perm, &mut PermuteScratch::default());
+    fields.visit(&mut |field| {
+        for (a, &i) in perm.iter().enumerate() {
+            let moved = match field.column {
+                ColumnRef::Ids(v) => v[a] == i,
+                ColumnRef::Scalars(v) => v[a].to_bits() == (i as f64).to_bits(),
+                ColumnRef::Vectors(v) => v[a] == Vector::<D>::repeat(i as f64),
+                ColumnRef::Flags(v) => v[a] == (i % 2 == 0),
+            };
+            assert!(moved, "field `{}` not permuted", field.name);
+        }
+    });
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -377,31 +404,4 @@ mod tests {
         });
         assert_eq!(lens, [("id", 2), ("s", 2), ("v", 0), ("f", 2)]);
     }
-}
-
-/// Test helper (also for the schemes' own declarations): fills every array of `fields`
-/// by index, applies a permutation and panics, naming the field, if an array did not move
-/// with it.
-#[cfg(test)]
-pub(crate) fn check_permutes_every_field<const D: usize>(fields: &mut impl Fields<D>) {
-    let n = 7;
-    fields.visit_mut(&mut |field| match field.column {
-        ColumnMut::Ids(v) => *v = (0..n as u32).collect(),
-        ColumnMut::Scalars(v) => *v = (0..n).map(|i| i as f64).collect(),
-        ColumnMut::Vectors(v) => *v = (0..n).map(|i| Vector::<D>::repeat(i as f64)).collect(),
-        ColumnMut::Flags(v) => *v = (0..n).map(|i| i % 2 == 0).collect(),
-    });
-    let perm: Vec<u32> = vec![3, 0, 6, 1, 5, 2, 4];
-    permute(fields, &perm, &mut PermuteScratch::default());
-    fields.visit(&mut |field| {
-        for (a, &i) in perm.iter().enumerate() {
-            let moved = match field.column {
-                ColumnRef::Ids(v) => v[a] == i,
-                ColumnRef::Scalars(v) => v[a] == i as f64,
-                ColumnRef::Vectors(v) => v[a] == Vector::<D>::repeat(i as f64),
-                ColumnRef::Flags(v) => v[a] == (i % 2 == 0),
-            };
-            assert!(moved, "field `{}` not permuted", field.name);
-        }
-    });
 }

@@ -69,49 +69,50 @@ pub fn divergence<const D: usize>(
 /// A D × D matrix.
 pub type Matrix<const D: usize> = SMatrix<f64, D, D>;
 
-/// The velocity gradient sum `G_a = Σ_b (u_b − u_a) ⊗ ∇_aW_ab` (without the volume).
+/// The velocity gradient sum `G_a = Σ_b V_b (u_b − u_a) ⊗ ∇_aW_ab`.
 #[inline]
 pub fn velocity_gradient_sum<const D: usize>(
     u: &[Vector<D>],
     a: usize,
-    pairs: &[Pair<D>],
-    nbrs: &[u32],
+    (pairs, nbrs): (&[Pair<D>], &[u32]),
+    volume: f64,
 ) -> Matrix<D> {
     let mut g = Matrix::<D>::zeros();
     for (p, &b) in pairs.iter().zip(nbrs) {
-        g += (u[b as usize] - u[a]) * (p.r_ab * p.f).transpose();
+        g += (u[b as usize] - u[a]) * (p.r_ab * (volume * p.f)).transpose();
     }
     g
 }
 
-/// The kernel-gradient corrected divergence (Bonet & Lok 1999): `tr(G_a M_a⁻¹)` with
-/// [`velocity_gradient_sum`] `G_a` and the inverse `m_inv` of the [`moment`] matrix; exact
-/// for linear velocity fields on any arrangement, a free surface included. Where `M_a` is
-/// singular (`None`: an isolated particle) it falls back to `V tr G_a`, the difference
-/// form.
+/// The kernel-gradient corrected divergence (Bonet & Lok 1999): `tr(G_a L_a)` with
+/// [`velocity_gradient_sum`] `G_a` and the correction `l` = `L_a` (the inverse of the
+/// [`moment`] matrix); exact for linear velocity fields on any arrangement, a free surface
+/// included. Where the moment matrix is singular (`None`: an isolated particle) it falls
+/// back to `tr G_a`, the difference form.
 #[inline]
 pub fn corrected_divergence<const D: usize>(
     u: &[Vector<D>],
     a: usize,
-    (pairs, nbrs): (&[Pair<D>], &[u32]),
+    row: (&[Pair<D>], &[u32]),
     volume: f64,
-    m_inv: Option<&Matrix<D>>,
+    l: Option<&Matrix<D>>,
 ) -> f64 {
-    let g = velocity_gradient_sum(u, a, pairs, nbrs);
-    match m_inv {
-        Some(mi) => (g * mi).trace(),
-        None => volume * g.trace(),
+    let g = velocity_gradient_sum(u, a, row, volume);
+    match l {
+        Some(l) => (g * l).trace(),
+        None => g.trace(),
     }
 }
 
-/// The moment matrix of the kernel-gradient correction (Bonet & Lok 1999 eq. 43, without
-/// the volume), `M_a = Σ_b (r_b − r_a) ⊗ ∇_aW_ab = −Σ_b r_ab ⊗ f r_ab` (symmetric; ≈ I/V in
-/// the bulk of a lattice); a corrected gradient is `M_a⁻¹ Σ_b (φ_b ∓ φ_a) ∇_aW_ab`.
+/// The moment matrix of the kernel-gradient correction (Bonet & Lok 1999 eq. 43),
+/// `M_a = Σ_b V_b (r_b − r_a) ⊗ ∇_aW_ab = −Σ_b r_ab ⊗ V f r_ab` (symmetric; ≈ I in the
+/// bulk of a lattice); `L_a = M_a⁻¹` corrects a gradient: `L_a Σ_b V_b (φ_b ∓ φ_a) ∇_aW_ab`
+/// (dimensionless).
 #[inline]
-pub fn moment<const D: usize>(pairs: &[Pair<D>]) -> Matrix<D> {
+pub fn moment<const D: usize>(pairs: &[Pair<D>], volume: f64) -> Matrix<D> {
     let mut m = Matrix::<D>::zeros();
     for p in pairs {
-        let grad = p.r_ab * p.f;
+        let grad = p.r_ab * (volume * p.f);
         m -= p.r_ab * grad.transpose();
     }
     m

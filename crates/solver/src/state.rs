@@ -112,7 +112,7 @@ pub struct State<const D: usize> {
     /// What each boundary particle's pressure and velocity are to the implicit systems
     /// (rebuilt every step by the `boundary_links` stage of a scene with boundaries).
     pub links: crate::boundary_map::BoundaryMap,
-    /// `M_a⁻¹` of the kernel-gradient correction for every fluid particle (`None` where
+    /// The kernel-gradient correction `L_a = M_a⁻¹` of every fluid particle (`None` where
     /// `M_a` is singular), from this step's pairs: filled by the `moments` stage of a
     /// scheme that corrects a gradient, empty otherwise ([`crate::operators::moment`]).
     pub moments: Vec<Option<crate::operators::Matrix<D>>>,
@@ -164,5 +164,17 @@ impl<const D: usize> State<D> {
     /// Largest fluid particle speed \[m/s\] (order-independent reduction).
     pub fn max_speed(&self) -> f64 {
         self.particles.u[..self.particles.fluid].iter().map(|u| u.norm_squared()).fold(0.0, f64::max).sqrt()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every declared particle field moves with the reorder's permutation.
+    #[test]
+    fn every_particle_field_is_permuted() {
+        crate::fields::check_permutes_every_field(&mut Particles::<2>::default());
+        crate::fields::check_permutes_every_field(&mut Particles::<3>::default());
     }
 }

@@ -232,7 +232,7 @@ impl<const D: usize, O> Stage<D, O> for Correction {
 
     fn run(&mut self, s: &mut State<D>, _own: &mut O, ctx: &StepContext) -> Result<(), Cause> {
         let (list, pairs, p, moments) = (&s.neighbours, &s.pairs, &s.particles.p, &s.moments);
-        let c = ctx.dt * s.volume / s.density;
+        let (c, v) = (ctx.dt * s.volume / s.density, s.volume);
         let sign = match self.form {
             PressureGradient::Symmetric => 1.0,
             PressureGradient::Difference | PressureGradient::Corrected => -1.0,
@@ -246,9 +246,9 @@ impl<const D: usize, O> Stage<D, O> for Correction {
                 g += pr.r_ab * (pr.f * (p[b as usize] + sign * p[a]));
             }
             if corrected {
-                // ∇p_a = (V M)⁻¹ (V g) with the step's moment matrix M (symmetric).
-                if let Some(mi) = &moments[a] {
-                    *u -= mi * g * dt_rho;
+                // ∇p_a = L_a (V g) with the step's correction L_a = M_a⁻¹ (symmetric).
+                if let Some(l) = &moments[a] {
+                    *u -= l * (g * v) * dt_rho;
                     return;
                 }
             }

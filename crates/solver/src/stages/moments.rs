@@ -1,5 +1,5 @@
-//! The kernel-gradient correction's matrices of the step: `M_a⁻¹` of every fluid particle
-//! from the step's pairs ([`crate::operators::moment`]), computed once for all the stages
+//! The kernel-gradient correction of the step: `L_a = M_a⁻¹` of every fluid particle from
+//! the step's pairs ([`crate::operators::moment`]), computed once for all the stages
 //! that correct a gradient (the corrected PPE divergence, the corrected pressure gradient,
 //! the shifting's Taylor correction of u).
 
@@ -20,10 +20,10 @@ impl<const D: usize, O> Stage<D, O> for Moments {
     }
 
     fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
-        let (list, pairs) = (&s.neighbours, &s.pairs);
+        let (list, pairs, v) = (&s.neighbours, &s.pairs, s.volume);
         s.moments.resize(s.particles.fluid, None);
         s.moments.par_iter_mut().enumerate().with_min_len(256).for_each(|(a, m)| {
-            *m = moment(&pairs[list.offsets[a]..list.offsets[a + 1]]).try_inverse();
+            *m = moment(&pairs[list.offsets[a]..list.offsets[a + 1]], v).try_inverse();
         });
         Ok(())
     }

@@ -116,10 +116,9 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
                     if r2 == 0.0 {
                         continue;
                     }
-                    // V ∇W for the concentration gradient; ∇W for the velocity gradient sum
-                    // (corrected by the step's moment matrix below).
-                    grad_c += p.r_ab * (v * p.f);
-                    g += (u[b as usize] - u[a]) * (p.r_ab * p.f).transpose();
+                    let grad = p.r_ab * (v * p.f);
+                    grad_c += grad;
+                    g += (u[b as usize] - u[a]) * grad.transpose();
                     if xu {
                         // n_ab / r_ab² (r̄² applied after the loop).
                         let r = r2.sqrt();
@@ -150,11 +149,11 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
                 if len > cap {
                     d *= cap / len;
                 }
-                // V M ≈ I in the bulk; fall back to V G where M is near singular (few
-                // neighbours: |(V M)⁻¹| ≥ 10).
+                // M ≈ I in the bulk; fall back to G where M is near singular (few
+                // neighbours: |L| ≥ 10), with the step's correction L = M⁻¹.
                 let grad_u = match &moments[a] {
-                    Some(mi) if mi.norm() < 10.0 * v => g * mi,
-                    _ => g * v,
+                    Some(l) if l.norm() < 10.0 => g * l,
+                    _ => g,
                 };
                 *shift = d;
                 *du = grad_u * d;

@@ -200,3 +200,14 @@ fn build_stages<K: Kernel, const D: usize>(
     }
     stages
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every declared field of the scheme moves with the reorder's permutation.
+    #[test]
+    fn every_wcsph_field_is_permuted() {
+        crate::fields::check_permutes_every_field(&mut WcFields::<2>::default());
+    }
+}
