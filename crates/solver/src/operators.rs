@@ -2,10 +2,10 @@
 //! from the pair cache ([`Pair`]): the Shao–Lo Laplacian's pair coefficient with its
 //! regularisation ([`ShaoLo`]), the velocity divergence in its difference and
 //! kernel-corrected forms ([`divergence`], [`corrected_divergence`]), and the moment
-//! matrix of the kernel-gradient correction ([`moment`]), which the `moments` stage
-//! inverts once per step for every stage that corrects a gradient
-//! ([`crate::stages::moments`]: the corrected divergence, the corrected pressure gradient,
-//! the shifting's Taylor correction).
+//! matrix of the kernel-gradient correction ([`moment`]), which the `neighbours` stage
+//! inverts once per step, in the pass that makes the pairs, for every stage that corrects
+//! a gradient ([`crate::stages::neighbours::Neighbours::inverting_moments`]: the corrected
+//! divergence, the corrected pressure gradient, the shifting's Taylor correction).
 //!
 //! Each function evaluates its formula in one fixed order of operations, the order the
 //! stages used before it was shared, so that moving a stage onto it changes no bit.

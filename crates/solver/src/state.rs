@@ -113,8 +113,9 @@ pub struct State<const D: usize> {
     /// (rebuilt every step by the `boundary_links` stage of a scene with boundaries).
     pub links: crate::boundary_map::BoundaryMap,
     /// The kernel-gradient correction `L_a = M_a⁻¹` of every fluid particle (`None` where
-    /// `M_a` is singular), from this step's pairs: filled by the `moments` stage of a
-    /// scheme that corrects a gradient, empty otherwise ([`crate::operators::moment`]).
+    /// `M_a` is singular), from this step's pairs ([`crate::operators::moment`]): filled by the
+    /// `neighbours` stage of a scheme that corrects a divergence or a gradient
+    /// ([`crate::stages::neighbours::Neighbours::inverting_moments`]), empty otherwise.
     pub moments: Vec<Option<crate::operators::Matrix<D>>>,
     /// Iterations and residual of the step's pressure solve (none for explicit schemes).
     pub solve: crate::linalg::SolveInfo,

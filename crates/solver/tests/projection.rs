@@ -72,7 +72,7 @@ fn solver_probe_reports_the_largest_pressure_of_the_fluid() {
 /// The assembled PPE matrix of the deformed drop is symmetric to the bit (each pair
 /// coefficient is rounded to the stored `f32` once, the same from both ends), and each row
 /// with no free-surface neighbour sums to zero to `f64` rounding: the diagonal is the sum
-/// of the rounded coefficients (`ppe::PpeMatrix`).
+/// of the rounded coefficients (`linalg::CsrMatrix`).
 #[test]
 fn assembled_matrix_is_symmetric_with_zero_interior_row_sums() {
     let scene = common::drop_scene(|v| {

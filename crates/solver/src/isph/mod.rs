@@ -2,9 +2,9 @@
 //!
 //! The step, built from the scene (a stage the scene does not need is not built):
 //! `reorder` (locality) → `advect` (eq. 3) → `walls` (§2.4.2; mirror walls only) →
-//! `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation) → `moments`
-//! (kernel-gradient correction matrices; with a corrected divergence or gradient, or
-//! shifting) →
+//! `neighbours` (with `div r`, and the kernel-gradient correction when a corrected
+//! divergence or gradient reads it) → `dummy_walls` (dummy walls only: Adami 2012
+//! extrapolation) →
 //! `inlet_sources` (inflow only) → `boundary_links` (walls or open boundaries: the
 //! boundary map) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
 //! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) or `surface_pressure`
@@ -39,7 +39,6 @@ use crate::scheme::{Adaptive, Composed, Scheme};
 use crate::stage::{Stage, StepContext};
 use crate::stages::boundary_links::BoundaryLinks;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
-use crate::stages::moments::Moments;
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
 use crate::stages::surface_tension::{Force, SurfaceTension};
@@ -149,18 +148,15 @@ fn build_stages<K: Kernel, const D: usize>(
         stages.push(Box::new(walls::Walls::new(&scene.boundaries.walls, kernel.support)));
     }
     let rows = if walls == Some(WallModel::Dummy) { Rows::All } else { Rows::Fluid };
-    // `div r` for the free-surface flags is summed in the neighbours' pair pass.
-    stages.push(Box::new(Neighbours::new(kernel, domain, rows).summing_div_r()));
+    // `div r` for the free-surface flags is summed in the neighbours' pair pass, and the
+    // kernel-gradient correction inverted there for the corrected divergence and gradient
+    // (and then read by the shifting's Taylor correction, instead of computing its own).
+    let corrected =
+        opts.divergence == Divergence::Corrected || opts.pressure_gradient == PressureGradient::Corrected;
+    let neighbours = Neighbours::new(kernel, domain, rows).summing_div_r();
+    stages.push(Box::new(if corrected { neighbours.inverting_moments() } else { neighbours }));
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Start)));
-    }
-    // The kernel-gradient correction's matrices, once for every stage that reads them.
-    let shifting = shifting::Law::of(opts.shifting);
-    if opts.divergence == Divergence::Corrected
-        || opts.pressure_gradient == PressureGradient::Corrected
-        || shifting.is_some()
-    {
-        stages.push(Box::new(Moments));
     }
     if open.is_some() {
         stages.push(Box::new(InletSources));
@@ -226,8 +222,9 @@ fn build_stages<K: Kernel, const D: usize>(
     }
     stages.push(Box::new(projection::Correction { form: opts.pressure_gradient }));
     stages.push(Box::new(projection::Position));
-    if let Some(law) = shifting {
-        stages.push(Box::new(shifting::Shifting::new(law, kernel, opts.free_surface_threshold)));
+    if let Some(law) = shifting::Law::of(opts.shifting) {
+        let shift = shifting::Shifting::new(law, kernel, opts.free_surface_threshold);
+        stages.push(Box::new(if corrected { shift.reading_moments() } else { shift }));
     }
     if let Some(o) = open {
         stages.push(Box::new(OpenBoundaries::new(o)));

@@ -532,7 +532,7 @@ pub struct PpeOptions {
     #[serde(default)]
     pub preconditioner: Preconditioner,
     /// Most solves between rebuilds of the two-level preconditioner's coarse space
-    /// (aggregates and factorised coarse matrix, kept across steps: `two_level.rs`; a
+    /// (aggregates and factorised coarse matrix, kept across steps: `linalg/two_level.rs`; a
     /// solve that shows it degraded brings the rebuild forward); default 25, at least 1.
     /// Unused with Jacobi.
     #[serde(default = "default_coarse_refresh")]
@@ -550,7 +550,7 @@ pub enum Preconditioner {
     /// `diag(A)⁻¹`.
     #[default]
     Jacobi,
-    /// Jacobi plus a coarse-space correction by aggregation (`two_level.rs`): for long
+    /// Jacobi plus a coarse-space correction by aggregation (`linalg/two_level.rs`): for long
     /// domains, whose smooth pressure modes Jacobi leaves to the Krylov iterations. A
     /// system with no Dirichlet row keeps Jacobi.
     TwoLevel,

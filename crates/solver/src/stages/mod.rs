@@ -5,7 +5,6 @@
 pub mod boundary_links;
 pub mod dummy;
 pub mod free_surface;
-pub mod moments;
 pub mod neighbours;
 pub mod open_boundary;
 pub mod reorder;

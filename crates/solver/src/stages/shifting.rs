@@ -73,6 +73,9 @@ pub struct Shifting<K: Kernel, const D: usize> {
     law: Law,
     threshold: f64,
     kernel: Scaled<K, D>,
+    /// Read the step's kernel-gradient correction from `State::moments` instead of
+    /// computing it in this stage's pair pass.
+    stored_moments: bool,
     shift: Vec<Vector<D>>,
     du: Vec<Vector<D>>,
 }
@@ -81,7 +84,15 @@ impl<K: Kernel, const D: usize> Shifting<K, D> {
     /// A stage applying `law` with `kernel`; `threshold` is the free-surface threshold on
     /// `div r`.
     pub fn new(law: Law, kernel: Scaled<K, D>, threshold: f64) -> Self {
-        Self { law, threshold, kernel, shift: Vec::new(), du: Vec::new() }
+        Self { law, threshold, kernel, stored_moments: false, shift: Vec::new(), du: Vec::new() }
+    }
+
+    /// Reads the kernel-gradient correction `L_a` that this step's `neighbours` stage
+    /// inverted ([`crate::stages::neighbours::Neighbours::inverting_moments`]) instead of
+    /// inverting the same matrix again (the same arithmetic: the same bits).
+    pub fn reading_moments(mut self) -> Self {
+        self.stored_moments = true;
+        self
     }
 }
 
@@ -103,10 +114,12 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
             Law::Fickian(_) => (false, false),
         };
         let inv_support2 = 1.0 / (k.support * k.support);
+        let stored = self.stored_moments;
         self.shift.par_iter_mut().zip(self.du.par_iter_mut()).enumerate().with_min_len(128).for_each(
             |(a, (shift, du))| {
                 let mut grad_c = Vector::<D>::zeros();
                 let mut g = SMatrix::<f64, D, D>::zeros();
+                let mut m = SMatrix::<f64, D, D>::zeros();
                 let mut xu_sum = Vector::<D>::zeros();
                 let mut r_sum = 0.0;
                 let mut w_sum = 0.0;
@@ -119,6 +132,10 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
                     let grad = p.r_ab * (v * p.f);
                     grad_c += grad;
                     g += (u[b as usize] - u[a]) * grad.transpose();
+                    if !stored {
+                        // The moment matrix (`operators::moment`) in this pass.
+                        m -= p.r_ab * grad.transpose();
+                    }
                     if xu {
                         // n_ab / r_ab² (r̄² applied after the loop).
                         let r = r2.sqrt();
@@ -151,7 +168,8 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for Shifting<K, D> {
                 }
                 // M ≈ I in the bulk; fall back to G where M is near singular (few
                 // neighbours: |L| ≥ 10), with the step's correction L = M⁻¹.
-                let grad_u = match &moments[a] {
+                let l = if stored { moments[a] } else { m.try_inverse() };
+                let grad_u = match l {
                     Some(l) if l.norm() < 10.0 => g * l,
                     _ => g,
                 };

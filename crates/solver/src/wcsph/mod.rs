@@ -3,8 +3,7 @@
 //! The step, built from the scene (a stage the scene does not need is not built):
 //! `reorder` (locality) → `wcsph_prime` (first step only: initial densities and forces) →
 //! `kick_drift` (half kick of u, drift of r; [`integrator`]) → `walls` (mirror walls only)
-//! → `neighbours` → `moments` (with shifting) → `dummy_walls` (dummy walls only: Adami
-//! 2012 extrapolation of u and p)
+//! → `neighbours` → `dummy_walls` (dummy walls only: Adami 2012 extrapolation of u and p)
 //! → `continuity` (ρ and the Tait pressure; density diffusion; [`forces`]) →
 //! `dummy_pressure` (dummy walls only) → `momentum` (Tait pressure gradient, Shao–Lo
 //! viscosity, Monaghan artificial viscosity, body force; [`forces`]) → `kick` (second half
@@ -27,7 +26,6 @@ use crate::scheme::{Adaptive, Composed, Scheme};
 use crate::stage::{Stage, StepContext};
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::free_surface::FreeSurface;
-use crate::stages::moments::Moments;
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::shifting::Law;
 use crate::stages::surface_tension::{Force, SurfaceTension};
@@ -176,10 +174,6 @@ fn build_stages<K: Kernel, const D: usize>(
         Box::new(integrator::KickDrift),
     ];
     stages.extend(boundaries(shifting.is_some()));
-    if shifting.is_some() {
-        // The shifting's Taylor correction of u reads the kernel-gradient correction.
-        stages.push(Box::new(Moments));
-    }
     stages.push(forces::continuity(
         params,
         kernel,
