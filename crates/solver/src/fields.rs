@@ -13,10 +13,13 @@
 //! [`Vectors`]: ColumnRef::Vectors
 //! [`Flags`]: ColumnRef::Flags
 
-use nalgebra::SVector;
+use nalgebra::{SMatrix, SVector};
 
 /// Vector type of the solver (positions, velocities, …) \[SI units of the field\].
 pub type Vector<const D: usize> = SVector<f64, D>;
+
+/// A D × D matrix (kernel-gradient corrections, velocity gradients, …).
+pub type Matrix<const D: usize> = SMatrix<f64, D, D>;
 
 /// One per-particle array, read-only.
 #[derive(Debug, Clone, Copy)]

@@ -10,8 +10,8 @@
 //! Each function evaluates its formula in one fixed order of operations, the order the
 //! stages used before it was shared, so that moving a stage onto it changes no bit.
 
+use crate::fields::Matrix;
 use crate::state::{Pair, Vector};
-use nalgebra::SMatrix;
 
 /// η²/h² of the Shao–Lo regularisation `r² + η²`, η² = 0.01 h² (Shao & Lo 2003 eq. 11;
 /// Qiu 2013 eq. 13; Morris, Fox & Zhu 1997 eq. 8): keeps the pair factor finite as
@@ -65,9 +65,6 @@ pub fn divergence<const D: usize>(
     }
     volume * div
 }
-
-/// A D × D matrix.
-pub type Matrix<const D: usize> = SMatrix<f64, D, D>;
 
 /// The velocity gradient sum `G_a = Σ_b V_b (u_b − u_a) ⊗ ∇_aW_ab`.
 #[inline]

@@ -116,7 +116,7 @@ pub struct State<const D: usize> {
     /// `M_a` is singular), from this step's pairs ([`crate::operators::moment`]): filled by the
     /// `neighbours` stage of a scheme that corrects a divergence or a gradient
     /// ([`crate::stages::neighbours::Neighbours::inverting_moments`]), empty otherwise.
-    pub moments: Vec<Option<crate::operators::Matrix<D>>>,
+    pub moments: Vec<Option<crate::fields::Matrix<D>>>,
     /// Iterations and residual of the step's pressure solve (none for explicit schemes).
     pub solve: crate::linalg::SolveInfo,
 }

@@ -1,9 +1,10 @@
 //! Neighbour stage: cell-list search and the pair cache.
 
 use crate::error::Cause;
+use crate::fields::Matrix;
 use crate::kernel::{Kernel, Scaled};
 use crate::neighbours::CellSearch;
-use crate::operators::{Matrix, moment};
+use crate::operators::moment;
 use crate::stage::{Stage, StepContext, par_rows_mut};
 use crate::state::{Pair, State};
 
