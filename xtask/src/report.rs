@@ -25,8 +25,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let cases = meniscus_harness::case::known_cases(&root.join("validation"))?;
     let baseline = args.baseline.as_deref().map(|dir| Baseline::load(dir, Some(&cases))).transpose()?;
     let extras = meniscus_harness::stability::extra_page(&out).into_iter().collect();
-    let rendered =
-        meniscus_harness::report::render(&out, &RenderOptions { cases: Some(cases), baseline, extras })?;
+    let rendered = meniscus_harness::report::render(
+        &out,
+        &RenderOptions { cases: Some(cases), baseline, extras, elapsed_s: None },
+    )?;
     if rendered.results.is_empty() {
         anyhow::bail!("no <case>/results.json under {}: run `cargo xtask validate` first", out.display());
     }

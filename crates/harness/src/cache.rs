@@ -34,10 +34,12 @@ pub struct RunRecord {
     /// The particles at the scene's `output.snapshot_times` (2D runs; absent when none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub snapshots: Vec<crate::snapshots::Snapshot>,
-    /// CPU time of the process (all threads) over the run \[s\], when the runner ran one
-    /// run at a time on Linux (the work-precision study reports it).
+    /// CPU time of the threads that ran the run (user + system) \[s\]; absent off Linux.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub cpu_s: Option<f64>,
+    /// Threads the run had (its rayon pool); absent in records written before it was kept.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub threads: Option<usize>,
 }
 
 impl RunRecord {
@@ -151,6 +153,7 @@ pub(crate) mod tests {
             },
             snapshots: Vec::new(),
             cpu_s: None,
+            threads: None,
         }
     }
 

@@ -27,21 +27,24 @@ impl Progress {
         Progress { multi: MultiProgress::with_draw_target(ProgressDrawTarget::hidden()), lines: false }
     }
 
-    /// A bar counting the runs of a case.
-    pub fn case_bar(&self, case: &str, runs: usize) -> ProgressBar {
-        let bar = self.multi.add(ProgressBar::new(runs as u64));
+    /// The bar of a batch of `runs` runs, `units` long (the runs' summed estimated cost):
+    /// shows the runs done and the ETA at the rate the units have been going.
+    pub fn batch_bar(&self, name: &str, units: u64, runs: usize) -> ProgressBar {
+        let bar = self.multi.add(ProgressBar::new(units.max(1)));
         bar.set_style(
             ProgressStyle::with_template(
-                "{prefix:>20.bold} [{bar:30.green/white}] {pos}/{len} runs {elapsed_precise} {msg}",
+                "{prefix:>20.bold} [{bar:30.green/white}] {percent:>3}% {msg} {elapsed_precise} ETA {eta_precise}",
             )
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
-        bar.set_prefix(case.to_string());
+        bar.set_prefix(name.to_string());
+        bar.set_message(format!("0/{runs} runs"));
         bar
     }
 
-    /// A bar for one run, in simulated time.
-    pub fn run_bar(&self, slug: &str) -> RunBar {
+    /// A bar for one run, in simulated time; with `batch` (the batch's bar and the run's
+    /// units of it), the batch's bar advances with the run.
+    pub fn run_bar(&self, slug: &str, batch: Option<(ProgressBar, u64)>) -> RunBar {
         let bar = self.multi.add(ProgressBar::new(TICKS));
         bar.set_style(
             ProgressStyle::with_template(
@@ -50,7 +53,7 @@ impl Progress {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
         );
         bar.set_prefix(slug.to_string());
-        RunBar { bar, last: u64::MAX }
+        RunBar { bar, last: u64::MAX, batch: batch.map(|(bar, units)| (bar, units, 0)) }
     }
 
     /// Prints a line above the bars, or plainly to stderr when the bars are hidden (so CI
@@ -72,11 +75,16 @@ impl Progress {
 pub struct RunBar {
     bar: ProgressBar,
     last: u64,
+    /// The batch's bar, the run's units of it and those already credited.
+    batch: Option<(ProgressBar, u64, u64)>,
 }
 
 impl RunBar {
-    /// Removes the bar.
+    /// Removes the bar and credits the batch with the rest of the run's units.
     pub fn finish(self) {
+        if let Some((batch, units, credited)) = &self.batch {
+            batch.inc(units.saturating_sub(*credited));
+        }
         self.bar.finish_and_clear();
     }
 }
@@ -88,6 +96,13 @@ impl meniscus::Observer for RunBar {
             self.last = pos;
             self.bar.set_position(pos);
             self.bar.set_message(format!("{time:.3e}"));
+            if let Some((batch, units, credited)) = &mut self.batch {
+                let due = *units * pos / TICKS;
+                if due > *credited {
+                    batch.inc(due - *credited);
+                    *credited = due;
+                }
+            }
         }
     }
 }

@@ -7,12 +7,18 @@
 //! - otherwise runs the scene in-process and stores the record atomically;
 //! - catches a panic inside the solver: the job ends [`Ran::Panicked`] with the message
 //!   (counted, never cached), and the other jobs go on;
-//! - runs `jobs` jobs at a time, each worker with its own rayon pool of an equal share of
-//!   the threads (small runs, like the channels' few thousand particles, gain nothing from a
-//!   second thread: their steps are bound by synchronisation); a job may ask for its own
-//!   thread count instead (the work-precision study's thread counts);
-//! - shows a bar per running run (simulated time) and, optionally, one counting the jobs
-//!   of a batch, and prints the line the study makes of each finished job.
+//! - starts the costliest jobs first ([`Job::cost`], an estimate), so that no long run
+//!   starts last while the other workers idle;
+//! - runs a *wide* job (one asking for every thread of the machine) alone, before the
+//!   others; the others `jobs` at a time, each worker with its own rayon pool of an equal
+//!   share of the threads (small runs, like the channels' few thousand particles, gain
+//!   nothing from a second thread: their steps are bound by synchronisation); a job may ask
+//!   for its own thread count instead (the work-precision study's thread counts);
+//! - measures each run's CPU time as the CPU time of the threads that ran it (the worker
+//!   and its pool), so it holds with several runs at once;
+//! - shows a bar per running run (simulated time) and, optionally, one for the batch whose
+//!   length is the jobs' summed cost, advanced as the runs advance, with its ETA; and prints
+//!   the line the study makes of each finished job.
 //!
 //! A reused record's times (`summary.wall_s`, `cpu_s`) are those measured when it ran.
 
@@ -21,6 +27,7 @@ use crate::error::{HarnessError, Result};
 use crate::progress::Progress;
 use crate::snapshots::Snapshot;
 use crate::sweep::RunSpec;
+use indicatif::ProgressBar;
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::sync::Mutex;
@@ -34,12 +41,16 @@ pub struct Job {
     /// Threads of the run's own rayon pool; `None`: the worker's share of the machine (all
     /// of the global pool when one job runs at a time).
     pub threads: Option<usize>,
+    /// Estimated cost (any unit shared by the batch, e.g. core-seconds): the costliest jobs
+    /// start first and the batch's bar measures progress in it; 0 when unknown (such jobs
+    /// keep their order, after the costed ones, and the bar counts each as one unit).
+    pub cost: f64,
 }
 
 impl Job {
-    /// A job on the worker's share of the threads.
+    /// A job on the worker's share of the threads, of unknown cost.
     pub fn new(spec: RunSpec) -> Self {
-        Job { spec, threads: None }
+        Job { spec, threads: None, cost: 0.0 }
     }
 }
 
@@ -138,12 +149,12 @@ impl Runner {
         f(&mut self.tally.lock().unwrap_or_else(|e| e.into_inner()));
     }
 
-    /// Runs (or reuses) `jobs`, their records under `<dir>/runs/`, with a bar counting them
-    /// when `bar` names the batch. `finish` turns job `i`'s outcome into the study's item
-    /// and the line printed for it (on the worker, as soon as the job ends). Returns the
-    /// items in job order. An invalid scene, a failed write or an error of `finish` is an
-    /// error: no job starts after it, and the first in job order is returned once the
-    /// running ones ended.
+    /// Runs (or reuses) `jobs`, their records under `<dir>/runs/`, with a bar for the batch
+    /// when `bar` names it. `finish` turns job `i`'s outcome into the study's item and the
+    /// line printed for it (on the worker, as soon as the job ends). Returns the items in
+    /// job order. An invalid scene, a failed write or an error of `finish` is an error: no
+    /// job starts after it, and the first in job order is returned once the running ones
+    /// ended.
     pub fn run<T: Send>(
         &self,
         dir: &Path,
@@ -151,58 +162,84 @@ impl Runner {
         jobs: &[Job],
         finish: impl Fn(usize, Ran) -> Result<(T, String)> + Sync,
     ) -> Result<Vec<T>> {
+        let placed: Vec<(&Path, &Job)> = jobs.iter().map(|j| (dir, j)).collect();
+        self.run_placed(bar, &placed, finish)
+    }
+
+    /// [`Runner::run`] with each job's own directory: the jobs of several cases in one batch
+    /// (so that the costliest of all start first).
+    pub fn run_placed<T: Send>(
+        &self,
+        bar: Option<&str>,
+        jobs: &[(&Path, &Job)],
+        finish: impl Fn(usize, Ran) -> Result<(T, String)> + Sync,
+    ) -> Result<Vec<T>> {
         let before = self.tally();
-        let batch = bar.map(|name| self.progress.case_bar(name, jobs.len()));
+        let units: Vec<u64> = jobs.iter().map(|(_, j)| bar_units(j.cost)).collect();
+        let batch = bar.map(|name| self.progress.batch_bar(name, units.iter().sum(), jobs.len()));
         let slots: Vec<Mutex<Option<Result<T>>>> = jobs.iter().map(|_| Mutex::new(None)).collect();
-        let next = AtomicUsize::new(0);
         let failed = AtomicBool::new(false);
-        let workers = self.jobs.min(jobs.len()).max(1);
-        let share = (workers > 1).then(|| (rayon::current_num_threads() / workers).max(1));
-        let worker = || {
-            let mut pools = BTreeMap::new();
-            while !failed.load(Ordering::Relaxed) {
-                let i = next.fetch_add(1, Ordering::Relaxed);
-                let Some(job) = jobs.get(i) else { break };
-                // A share that cannot be had runs on the global pool; asked-for threads must be.
-                let pool = match job.threads.or(share).map(|k| {
-                    (
-                        k,
-                        pools
-                            .entry(k)
-                            .or_insert_with(|| rayon::ThreadPoolBuilder::new().num_threads(k).build()),
-                    )
-                }) {
-                    Some((_, Ok(pool))) => Ok(Some(&*pool)),
-                    Some((k, Err(e))) if job.threads.is_some() => Err(HarnessError::case(
-                        &job.spec.case,
-                        format!("run {}: no rayon pool of {k} threads: {e}", job.spec.slug),
-                    )),
-                    _ => Ok(None),
-                };
-                let item = pool.and_then(|pool| self.one(dir, job, pool)).and_then(|ran| finish(i, ran)).map(
-                    |(item, line)| {
-                        self.progress.println(&line);
-                        item
-                    },
-                );
-                if let Some(b) = &batch {
-                    b.inc(1);
+        let done = AtomicUsize::new(0);
+        let all = rayon::current_num_threads();
+        // Costliest first (a stable sort: jobs of unknown cost keep their order, last).
+        let mut order: Vec<usize> = (0..jobs.len()).collect();
+        order.sort_by(|&a, &b| jobs[b].1.cost.total_cmp(&jobs[a].1.cost));
+        let (wide, narrow): (Vec<usize>, Vec<usize>) =
+            order.into_iter().partition(|&i| self.jobs > 1 && jobs[i].1.threads.is_some_and(|k| k >= all));
+        let phase = |queue: &[usize], workers: usize| {
+            let next = AtomicUsize::new(0);
+            let share = (workers > 1).then(|| (all / workers).max(1));
+            let worker = || {
+                let mut pools = BTreeMap::new();
+                while !failed.load(Ordering::Relaxed) {
+                    let Some(&i) = queue.get(next.fetch_add(1, Ordering::Relaxed)) else { break };
+                    let (dir, job) = jobs[i];
+                    // A share that cannot be had runs on the global pool; asked-for threads must be.
+                    let pool = match job.threads.or(share).map(|k| {
+                        (
+                            k,
+                            pools
+                                .entry(k)
+                                .or_insert_with(|| rayon::ThreadPoolBuilder::new().num_threads(k).build()),
+                        )
+                    }) {
+                        Some((_, Ok(pool))) => Ok(Some(&*pool)),
+                        Some((k, Err(e))) if job.threads.is_some() => Err(HarnessError::case(
+                            &job.spec.case,
+                            format!("run {}: no rayon pool of {k} threads: {e}", job.spec.slug),
+                        )),
+                        _ => Ok(None),
+                    };
+                    let share = batch.as_ref().map(|b| (b.clone(), units[i]));
+                    let item = pool
+                        .and_then(|pool| self.one(dir, job, pool, share))
+                        .and_then(|ran| finish(i, ran))
+                        .map(|(item, line)| {
+                            self.progress.println(&line);
+                            item
+                        });
+                    if let Some(b) = &batch {
+                        let n = done.fetch_add(1, Ordering::Relaxed) + 1;
+                        b.set_message(format!("{n}/{} runs", jobs.len()));
+                    }
+                    if item.is_err() {
+                        failed.store(true, Ordering::Relaxed);
+                    }
+                    *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(item);
                 }
-                if item.is_err() {
-                    failed.store(true, Ordering::Relaxed);
-                }
-                *slots[i].lock().unwrap_or_else(|e| e.into_inner()) = Some(item);
+            };
+            if workers <= 1 {
+                worker();
+            } else {
+                std::thread::scope(|s| {
+                    for _ in 0..workers {
+                        s.spawn(worker);
+                    }
+                });
             }
         };
-        if workers == 1 {
-            worker();
-        } else {
-            std::thread::scope(|s| {
-                for _ in 0..workers {
-                    s.spawn(worker);
-                }
-            });
-        }
+        phase(&wide, 1);
+        phase(&narrow, self.jobs.min(narrow.len()).max(1));
         if let Some(b) = batch {
             let t = self.tally();
             b.finish_with_message(format!(
@@ -211,34 +248,46 @@ impl Runner {
                 t.reused - before.reused
             ));
         }
-        // Jobs are taken in order, so every job before the first failed one ran.
-        let items = slots
-            .into_iter()
-            .map_while(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
-            .collect::<Result<Vec<T>>>()?;
-        assert_eq!(items.len(), jobs.len(), "without an error every job ran");
-        Ok(items)
+        let mut items = Vec::with_capacity(jobs.len());
+        for slot in slots {
+            match slot.into_inner().unwrap_or_else(|e| e.into_inner()) {
+                Some(item) => items.push(item),
+                // Not started: an error stopped the batch, and is returned below.
+                None => assert!(failed.load(Ordering::Relaxed), "without an error every job ran"),
+            }
+        }
+        items.into_iter().collect()
     }
 
     /// Reuses or runs one job (on `pool` when given).
-    fn one(&self, dir: &Path, job: &Job, pool: Option<&rayon::ThreadPool>) -> Result<Ran> {
+    /// `batch`: the batch's bar and the job's share of it.
+    fn one(
+        &self,
+        dir: &Path,
+        job: &Job,
+        pool: Option<&rayon::ThreadPool>,
+        batch: Option<(ProgressBar, u64)>,
+    ) -> Result<Ran> {
         let spec = &job.spec;
         let path = cache::record_path(dir, &spec.slug);
         if !self.force
             && let Some(record) = cache::load(&path, &spec.hash)
         {
             self.count(|t| t.reused += 1);
+            if let Some((b, units)) = batch {
+                b.inc(units);
+            }
             return Ok(Ran::Finished { record: Box::new(record), reused: true });
         }
         self.count(|t| t.executed += 1);
-        let mut bar = self.progress.run_bar(&spec.slug);
-        // CPU time is the whole process's: meaningful only with one run at a time.
-        let cpu0 = (self.jobs == 1).then(process_cpu_s).flatten();
+        let mut bar = self.progress.run_bar(&spec.slug, batch);
+        let threads = pool.map_or_else(rayon::current_num_threads, rayon::ThreadPool::current_num_threads);
+        let cpu0 = run_cpu_s(pool);
         let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| match pool {
             Some(pool) => pool.install(|| (self.solve)(&spec.scene, &mut bar)),
             None => (self.solve)(&spec.scene, &mut bar),
         }));
-        let cpu_s = cpu0.and_then(|a| process_cpu_s().map(|b| b - a));
+        let cpu_s = cpu0.and_then(|a| run_cpu_s(pool).map(|b| b - a));
         bar.finish();
         match run {
             Ok(Ok(report)) => {
@@ -254,6 +303,7 @@ impl Runner {
                     probes: CachedProbes::from(report.probes),
                     snapshots: report.snapshots.iter().map(Snapshot::from).collect(),
                     cpu_s,
+                    threads: Some(threads),
                 };
                 cache::store(&path, &record)?;
                 Ok(Ran::Finished { record: Box::new(record), reused: false })
@@ -274,10 +324,27 @@ impl Runner {
     }
 }
 
-/// CPU time of this process, user + system, all threads \[s\] (`/proc/self/stat` fields 14
+/// Units of a job of estimated `cost` on the batch's bar (milliseconds of the estimate; one
+/// unit when unknown).
+fn bar_units(cost: f64) -> u64 {
+    if cost > 0.0 && cost.is_finite() { (cost * 1e3).ceil() as u64 } else { 1 }
+}
+
+/// CPU time so far of the threads that run a job \[s\]: the calling thread (which runs the
+/// serial parts when `pool` is `None`) and every thread of `pool` or of the global pool.
+/// `None` off Linux.
+fn run_cpu_s(pool: Option<&rayon::ThreadPool>) -> Option<f64> {
+    let workers: Vec<Option<f64>> = match pool {
+        Some(pool) => pool.broadcast(|_| thread_cpu_s()),
+        None => rayon::broadcast(|_| thread_cpu_s()),
+    };
+    workers.into_iter().chain([thread_cpu_s()]).sum()
+}
+
+/// CPU time of the calling thread, user + system \[s\] (`/proc/thread-self/stat` fields 14
 /// and 15, in clock ticks of 1/100 s, the Linux value); `None` off Linux.
-fn process_cpu_s() -> Option<f64> {
-    let stat = std::fs::read_to_string("/proc/self/stat").ok()?;
+fn thread_cpu_s() -> Option<f64> {
+    let stat = std::fs::read_to_string("/proc/thread-self/stat").ok()?;
     // Fields after the command name (which may hold spaces) start at field 3.
     let rest = &stat[stat.rfind(')')? + 1..];
     let f: Vec<&str> = rest.split_whitespace().collect();
@@ -297,6 +364,45 @@ mod tests {
     ) -> std::result::Result<meniscus::RunReport, meniscus::SceneError> {
         assert!(scene.name != "panics", "the solver panicked on purpose");
         meniscus::run(scene, observer)
+    }
+
+    /// The costliest jobs start first and a wide job (every thread) runs alone before the
+    /// others; the items come back in job order.
+    #[test]
+    fn costliest_first_and_wide_jobs_alone() {
+        let mut case = crate::case::testing::committed("elliptical_drop");
+        case.scene["time"]["end"] = serde_json::json!(2e-4);
+        let all = rayon::current_num_threads();
+        let job = |name: &str, cost: f64, threads: Option<usize>| {
+            let mut spec = crate::sweep::spec(&case, "paper", 0.1).unwrap();
+            spec.slug = name.into();
+            Job { threads, cost, ..Job::new(spec) }
+        };
+        let jobs = [
+            job("cheap", 1.0, None),
+            job("dear", 3.0, None),
+            job("wide", 0.5, Some(all)),
+            job("mid", 2.0, None),
+        ];
+        let dir = Scratch::new("runner-order");
+        for workers in [1, 2] {
+            let finished = Mutex::new(Vec::new());
+            let runner = Runner::new(Progress::silent(), true, workers);
+            let out = runner
+                .run(dir.path(), Some("order"), &jobs, |i, _| {
+                    finished.lock().unwrap().push(jobs[i].spec.slug.clone());
+                    Ok((i, String::new()))
+                })
+                .unwrap();
+            assert_eq!(out, [0, 1, 2, 3], "job order");
+            let finished = finished.into_inner().unwrap();
+            if workers == 1 {
+                // One at a time: costliest first, the wide job among them by its cost.
+                assert_eq!(finished, ["dear", "mid", "cheap", "wide"]);
+            } else {
+                assert_eq!(finished[0], "wide", "the wide job runs alone, first: {finished:?}");
+            }
+        }
     }
 
     /// Two tiny drops (dx = 0.1, 10 steps), one of which panics: the panic is that job's

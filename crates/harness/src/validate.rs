@@ -16,7 +16,7 @@ use crate::runner::{Job, Ran, Runner};
 use crate::sweep::{self, RunSpec};
 use crate::tier::Tier;
 use std::collections::BTreeMap;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Options of a validation.
 #[derive(Debug, Clone)]
@@ -63,6 +63,7 @@ impl Outcome {
 
 /// Runs the validation described by `opts`; failed checks are results, not errors.
 pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
+    let started = std::time::Instant::now();
     let paths = case::discover(&opts.validation_dir, &opts.cases)?;
     let cases: Vec<Case> = paths.iter().map(|p| Case::load(p)).collect::<Result<_>>()?;
     let known = case::known_cases(&opts.validation_dir)?;
@@ -72,23 +73,34 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     let runner = Runner::new(Progress::new(opts.progress), opts.force, opts.jobs);
     let provenance = Provenance::collect(&opts.workspace);
     let mut outcome = Outcome { results: Vec::new(), executed: 0, reused: 0, comparison: None };
-    for case in &cases {
-        let jobs: Vec<Job> = sweep::expand(case, opts.tier)?.into_iter().map(Job::new).collect();
-        let case_dir = opts.out.join(&case.case);
-        let ran = runner.run(&case_dir, Some(&case.case), &jobs, |i, ran| {
-            let spec = &jobs[i].spec;
-            let line = match &ran {
-                Ran::Finished { record, reused } => format!(
-                    "  {} {} ({:.1} s{})",
-                    spec.slug,
-                    record.status(),
-                    record.summary.wall_s,
-                    if *reused { ", cached" } else { "" }
-                ),
-                Ran::Panicked { .. } => format!("  {} {}", spec.slug, ran.status()),
-            };
-            Ok((ran, line))
-        })?;
+    // Every case's runs in one batch, so that the costliest of the tier start first.
+    let planned: Vec<(PathBuf, Vec<Job>)> = cases
+        .iter()
+        .map(|case| {
+            let jobs = sweep::expand(case, opts.tier)?.into_iter().map(plan).collect::<Result<_>>()?;
+            Ok((opts.out.join(&case.case), jobs))
+        })
+        .collect::<Result<_>>()?;
+    let placed: Vec<(&Path, &Job)> =
+        planned.iter().flat_map(|(dir, jobs)| jobs.iter().map(move |j| (dir.as_path(), j))).collect();
+    let ran = runner.run_placed(Some(opts.tier.name()), &placed, |i, ran| {
+        let spec = &placed[i].1.spec;
+        let line = match &ran {
+            Ran::Finished { record, reused } => format!(
+                "  {}/{} {} ({:.1} s{})",
+                spec.case,
+                spec.slug,
+                record.status(),
+                record.summary.wall_s,
+                if *reused { ", cached" } else { "" }
+            ),
+            Ran::Panicked { .. } => format!("  {}/{} {}", spec.case, spec.slug, ran.status()),
+        };
+        Ok((ran, line))
+    })?;
+    let mut ran = ran.into_iter();
+    for (case, (case_dir, jobs)) in cases.iter().zip(&planned) {
+        let ran: Vec<Ran> = ran.by_ref().take(jobs.len()).collect();
         for r in ran.iter().filter_map(Ran::record).filter(|r| !r.snapshots.is_empty()) {
             let file = crate::snapshots::SnapshotFile {
                 slug: r.slug.clone(),
@@ -97,7 +109,7 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
                 status: r.status(),
                 frames: r.snapshots.clone(),
             };
-            crate::snapshots::store(&case_dir, &file)?;
+            crate::snapshots::store(case_dir, &file)?;
         }
         let runs = jobs
             .iter()
@@ -123,9 +135,37 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     let tally = runner.tally();
     (outcome.executed, outcome.reused) = (tally.executed, tally.reused);
     let extras = crate::stability::extra_page(&opts.out).into_iter().collect();
-    let rendered = report::render(&opts.out, &RenderOptions { cases: Some(known), baseline, extras })?;
+    let elapsed_s = Some(started.elapsed().as_secs_f64());
+    let rendered =
+        report::render(&opts.out, &RenderOptions { cases: Some(known), baseline, extras, elapsed_s })?;
     outcome.comparison = rendered.comparison;
     Ok(outcome)
+}
+
+/// Runs with at least this many particles get every thread of the machine (and run alone,
+/// first); smaller ones one worker's share. Measured on the 2-core machine
+/// (docs/notes/scheduling.md): a second thread speeds one run up 1.5–1.8 times (3200 to
+/// 96 000 particles), two one-thread runs at once give 2.0–2.2 times the throughput; so
+/// one thread per run wins, except for a run long enough to be the batch's critical path —
+/// the open channel at Δx = 0.0025 (96 000 particles), not the next largest (37 500).
+pub const WIDE_PARTICLES: usize = 50_000;
+
+/// Estimated cost of one particle-step \[core-s\] (the paper drop at Δx = 0.02: about
+/// 1.5 core-µs): scales the estimate of [`plan`] to seconds for the progress bar's ETA.
+const CORE_S_PER_PARTICLE_STEP: f64 = 1.5e-6;
+
+/// The job of a run: its thread count from its particle count ([`WIDE_PARTICLES`]) and its
+/// estimated cost, `particles × end / Δt₀ × 1.5 core-µs` with the first step's Δt (built
+/// from the scene before anything runs; a scene that cannot start is costed as zero, and
+/// its error is the run's).
+fn plan(spec: RunSpec) -> Result<Job> {
+    let (particles, steps) = match meniscus::AnySimulation::new(&spec.scene) {
+        Ok(sim) => (sim.particles(), sim.first_step().map_or(0.0, |dt| (spec.scene.time.end / dt).ceil())),
+        Err(_) => (0, 0.0),
+    };
+    let threads = (particles >= WIDE_PARTICLES).then(rayon::current_num_threads);
+    let cost = particles as f64 * steps * CORE_S_PER_PARTICLE_STEP;
+    Ok(Job { threads, cost, ..Job::new(spec) })
 }
 
 /// A run of `case` as its results file shows it: the metrics of its probes against the
@@ -138,6 +178,8 @@ pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
         particles: 0,
         steps: 0,
         wall_s: 0.0,
+        cpu_s: None,
+        threads: None,
         status: ran.status(),
         metrics: BTreeMap::new(),
         series: BTreeMap::new(),
@@ -147,6 +189,7 @@ pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
         let measured = metrics::compute(&case.reference, &r.scene, &probes, r.summary.particles)
             .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
         (run.particles, run.steps, run.wall_s) = (r.summary.particles, r.summary.steps, r.summary.wall_s);
+        (run.cpu_s, run.threads) = (r.cpu_s, r.threads);
         (run.metrics, run.series) = (measured.metrics, measured.series);
     }
     Ok(run)

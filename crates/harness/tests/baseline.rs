@@ -102,9 +102,11 @@ fn marks_appear_in_summary_md_and_html() {
     std::fs::write(out.join("old_case/results.json"), "not even JSON").unwrap();
     let cases = vec!["elliptical_drop".to_string()];
     let base = Baseline::load(&fixtures().join("base"), Some(&cases)).unwrap();
-    let rendered =
-        report::render(&out, &RenderOptions { cases: Some(cases), baseline: Some(base), extras: Vec::new() })
-            .unwrap();
+    let rendered = report::render(
+        &out,
+        &RenderOptions { cases: Some(cases), baseline: Some(base), extras: Vec::new(), elapsed_s: None },
+    )
+    .unwrap();
     assert_eq!(rendered.results.len(), 1);
     assert!(rendered.comparison.unwrap().tally().regressed());
 
@@ -112,7 +114,7 @@ fn marks_appear_in_summary_md_and_html() {
     for needle in [
         "| elliptical_drop | isph | quick | 0.04, 0.02 |",
         "## Failed checks",
-        "- `elliptical_drop`: b error at dx=0.04 <= 1.8% (paper): value 2.0000e-2",
+        "- `elliptical_drop`: b error at dx=0.04 <= 1.8% (paper): FAIL, value 2.0000e-2",
         "## Compared with baseline",
         "more than 5 % of its baseline value",
         "| isph-paper_dx0.04 | `b_rel_err_max` | 1.600 % | 2.000 % | +25.0 % | **worse** |",

@@ -154,6 +154,16 @@ impl AnySimulation {
         }
     }
 
+    /// Δt of the first step \[s\]: the scene's fixed step, or the scheme's stable step of the
+    /// initial state. With the particle count it estimates what a run costs (about
+    /// `particles × end / Δt₀` particle-steps) before it runs.
+    pub fn first_step(&self) -> Result<f64, Cause> {
+        match self {
+            AnySimulation::Two(s) => s.time_step(f64::INFINITY),
+            AnySimulation::Three(s) => s.time_step(f64::INFINITY),
+        }
+    }
+
     /// Makes [`AnySimulation::run`] stop after `steps` steps if the end time is not reached
     /// before (a truncated run; its last step is recorded like the end).
     pub fn stop_after(&mut self, steps: usize) {

@@ -3,7 +3,7 @@
 use super::FigureFile;
 use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
 use crate::case::CaseRecord;
-use crate::results::{CaseResults, CheckResult, RunResult, Summary};
+use crate::results::{CaseResults, CheckResult, RunResult, Summary, Verdict, expected_failures};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
 const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1200px;color:#222}\
@@ -12,7 +12,8 @@ th{background:#f0f0f0}td.l,th.l{text-align:left}.pass{background:#d9f2d9;color:#
 .fail{background:#f8d7d7;color:#7a1010}pre{background:#f6f6f6;padding:1em;overflow-x:auto;font-size:85%}\
 figure{display:inline-block;margin:0.5em}figcaption{font-size:90%;color:#555}code{font-size:90%}\
 .better{background:#d9f2d9;color:#145214}.worse{background:#f8d7d7;color:#7a1010}\
-.changed{background:#fff3cd;color:#664d03}.note{color:#555;font-size:90%}";
+.changed{background:#fff3cd;color:#664d03}.note{color:#555;font-size:90%}\
+.xfail{background:#ececec;color:#444}";
 
 /// Formats a metric: relative errors (`rel_err`, `_l2_rel`, `_linf_rel`) and drifts in
 /// percent, counts as integers.
@@ -179,6 +180,22 @@ fn baseline_section(cmp: &Comparison, case: &CaseComparison) -> Markup {
     }
 }
 
+/// A check's verdict: pass, FAIL, expected fail (grey) or UNEXPECTED PASS (red).
+pub(crate) fn verdict_cell(v: Verdict) -> Markup {
+    let class = match v {
+        Verdict::Pass => "pass",
+        Verdict::ExpectedFail => "xfail",
+        Verdict::Fail | Verdict::UnexpectedPass => "fail",
+    };
+    html! { td class=(class) { (v.label()) } }
+}
+
+/// The note of a check: why it failed, and why it is expected to.
+fn check_note(c: &CheckResult) -> String {
+    let expected = c.expected_failure.as_deref().map(|r| format!("expected to fail: {r}"));
+    [c.note.clone(), expected].into_iter().flatten().collect::<Vec<_>>().join("; ")
+}
+
 pub(crate) fn pass_cell(pass: bool) -> Markup {
     html! { td class=(if pass { "pass" } else { "fail" }) { (if pass { "PASS" } else { "FAIL" }) } }
 }
@@ -193,8 +210,8 @@ pub(crate) fn checks_table(checks: &[CheckResult], number: fn(f64) -> String) ->
                     td class="l" { (c.name) }
                     td { (c.value.map_or("—".to_string(), number)) }
                     td { (c.threshold.map_or("—".to_string(), number)) }
-                    (pass_cell(c.pass))
-                    td class="l" { (c.note.as_deref().unwrap_or("")) }
+                    (verdict_cell(c.verdict()))
+                    td class="l" { (check_note(c)) }
                 }
             }
         }
@@ -271,6 +288,8 @@ pub fn case_page(
             span class=(if failed == 0 { "pass" } else { "fail" }) {
                 (passed) " / " (passed + failed) " checks passed"
             }
+            @let xfail = expected_failures(&results.checks);
+            @if xfail > 0 { " " span class="xfail" { (xfail) " expected failure(s)" } }
         }
         h2 { "Checks" }
         (checks_table(&results.checks, |v| format!("{v:.4e}")))
@@ -438,6 +457,7 @@ pub fn index_page(
         h1 { "Meniscus validation" }
         p class=(if summary.pass { "pass" } else { "fail" }) {
             (summary.passed) " / " (summary.passed + summary.failed) " checks passed over " (results.len()) " cases"
+            @if summary.expected_failures > 0 { ", " (summary.expected_failures) " expected failure(s) apart" }
         }
         @if let Some(cmp) = comparison {
             p { "Compared with baseline " code { (cmp.baseline.display()) } ": " (cmp.tally().describe()) "." }
@@ -460,12 +480,17 @@ pub fn index_page(
                     td class="l" { (key_errors(r, rec)) }
                     td class="l" { (key_order(r, rec)) }
                     td { (format!("{:.1}", r.runs.iter().map(|x| x.wall_s).sum::<f64>())) }
-                    td { (passed) " / " (passed + failed) }
+                    td {
+                        (passed) " / " (passed + failed)
+                        @let xfail = expected_failures(&r.checks);
+                        @if xfail > 0 { " (+" (xfail) " expected fail)" }
+                    }
                     (pass_cell(failed == 0))
                     @if let Some(cmp) = comparison { (baseline_cell(cmp.case(&r.case))) }
                 }
             }
         }
+        (super::timing::html_section(results, summary.elapsed_s))
         @if !extras.is_empty() {
             h2 { "Stress tests" }
             table {

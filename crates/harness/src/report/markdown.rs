@@ -8,7 +8,7 @@ use super::html::{
 };
 use crate::baseline::{CaseComparison, Comparison, Mark};
 use crate::case::CaseRecord;
-use crate::results::{CaseResults, Summary};
+use crate::results::{CaseResults, Summary, Verdict};
 use std::fmt::Write;
 
 /// Makes `text` safe inside a table cell (no pipes, no line breaks).
@@ -39,11 +39,16 @@ fn write_summary(
     writeln!(md, "# Meniscus validation\n")?;
     writeln!(
         md,
-        "**{}**: {} / {} checks passed over {} case(s).\n",
+        "**{}**: {} / {} checks passed over {} case(s){}.\n",
         if summary.pass { "PASS" } else { "FAIL" },
         summary.passed,
         summary.passed + summary.failed,
-        results.len()
+        results.len(),
+        if summary.expected_failures > 0 {
+            format!(", {} expected failure(s) apart", summary.expected_failures)
+        } else {
+            String::new()
+        }
     )?;
     let with_baseline = comparison.is_some();
     write!(md, "| case | scheme | tier | dx | key errors | observed order | wall [s] | checks | result |")?;
@@ -78,21 +83,46 @@ fn write_summary(
         writeln!(md)?;
     }
     writeln!(md, "\n## Failed checks\n")?;
+    write_checks(md, results, |v| !v.expected())?;
+    if summary.expected_failures > 0 {
+        writeln!(md, "\n## Expected failures\n")?;
+        write_checks(md, results, |v| v == Verdict::ExpectedFail)?;
+    }
+    super::timing::markdown_section(md, results, summary.elapsed_s)?;
+    if let Some(cmp) = comparison {
+        write_comparison(md, cmp)?;
+    }
+    Ok(())
+}
+
+/// One line per check whose verdict `shown` picks, or `None.`.
+fn write_checks(
+    md: &mut String,
+    results: &[CaseResults],
+    shown: impl Fn(Verdict) -> bool,
+) -> std::fmt::Result {
     let mut any = false;
     for r in results {
-        for c in r.checks.iter().filter(|c| !c.pass) {
+        for c in r.checks.iter().filter(|c| shown(c.verdict())) {
             any = true;
             let value = c.value.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
             let threshold = c.threshold.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
             let note = c.note.as_deref().map(|n| format!(" — {n}")).unwrap_or_default();
-            writeln!(md, "- `{}`: {}: value {value}, threshold {threshold}{note}", r.case, c.name)?;
+            let verdict = c.verdict().label();
+            let reason = c
+                .expected_failure
+                .as_deref()
+                .map(|r| format!(" (expected to fail: {r})"))
+                .unwrap_or_default();
+            writeln!(
+                md,
+                "- `{}`: {}: {verdict}, value {value}, threshold {threshold}{note}{reason}",
+                r.case, c.name
+            )?;
         }
     }
     if !any {
         writeln!(md, "None.")?;
-    }
-    if let Some(cmp) = comparison {
-        write_comparison(md, cmp)?;
     }
     Ok(())
 }

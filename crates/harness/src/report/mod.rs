@@ -9,6 +9,7 @@
 pub mod html;
 pub mod markdown;
 pub mod plots;
+pub mod timing;
 
 pub use html::ExtraPage;
 
@@ -199,6 +200,9 @@ pub struct RenderOptions {
     pub baseline: Option<Baseline>,
     /// Pages beside the cases that the index links (the stability envelope's).
     pub extras: Vec<ExtraPage>,
+    /// Wall time of the invocation that produced the results \[s\] (shown beside the runs'
+    /// summed times).
+    pub elapsed_s: Option<f64>,
 }
 
 /// What [`render`] produced.
@@ -227,7 +231,7 @@ pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
     for (results, record) in &found {
         render_case(&out.join(&results.case), results, record.as_ref(), comparison.as_ref())?;
     }
-    let summary = Summary::of(&results);
+    let summary = Summary { elapsed_s: opts.elapsed_s, ..Summary::of(&results) };
     io::write_json(&out.join("summary.json"), &summary)?;
     let records: Vec<Option<&CaseRecord>> = found.iter().map(|f| f.1.as_ref()).collect();
     let page = html::index_page(&results, &records, &summary, comparison.as_ref(), &opts.extras);

@@ -504,6 +504,8 @@ fn row_run(base: &Base, set: &OptionSet, trials: &[Trial], particles: usize) -> 
         particles,
         steps: trials.iter().map(|t| t.steps).sum(),
         wall_s: trials.iter().map(|t| t.wall_s).sum(),
+        cpu_s: None,
+        threads: None,
         status: "ok".into(),
         metrics: BTreeMap::new(),
         series: BTreeMap::new(),
@@ -747,7 +749,10 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
     // The index links the study.
     let cases = Some(crate::case::known_cases(&opts.validation_dir)?);
     let extras = vec![results.index_entry()];
-    crate::report::render(&opts.out, &crate::report::RenderOptions { cases, baseline: None, extras })?;
+    crate::report::render(
+        &opts.out,
+        &crate::report::RenderOptions { cases, baseline: None, extras, elapsed_s: None },
+    )?;
     Ok(results)
 }
 
@@ -765,6 +770,7 @@ pub fn checks(specs: &[Check], rows: &[Row], panics: usize, tier: Tier) -> Vec<C
         threshold: Some(0.0),
         pass,
         note: note.map(str::to_string),
+        expected_failure: None,
     };
     specs
         .iter()
@@ -785,6 +791,7 @@ pub fn checks(specs: &[Check], rows: &[Row], panics: usize, tier: Tier) -> Vec<C
                     threshold: spec.threshold(),
                     pass: false,
                     note: spec.missing.clone(),
+                    expected_failure: spec.expected_failure.clone(),
                 })
             }),
             Check::Jittered { name, preset, fraction, rows: expected, missing } => {
@@ -992,6 +999,8 @@ mod tests {
                 particles: 1,
                 steps: 1,
                 wall_s: 1.0,
+                cpu_s: None,
+                threads: None,
                 status: "diverged: at step 3".into(),
                 metrics: metrics.iter().map(|(k, v)| (k.to_string(), *v)).collect(),
                 series: BTreeMap::new(),

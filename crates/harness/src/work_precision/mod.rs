@@ -79,7 +79,7 @@ fn loadavg() -> Option<String> {
 /// A job of the study: run `id` of `case` with `scene`, on `threads` threads.
 fn job(case: &Case, id: String, dx: f64, scene: meniscus::Scene, threads: usize) -> Result<Job> {
     let preset = id.clone();
-    Ok(Job { spec: RunSpec::new(&case.case, id, &preset, dx, scene)?, threads: Some(threads) })
+    Ok(Job { threads: Some(threads), ..Job::new(RunSpec::new(&case.case, id, &preset, dx, scene)?) })
 }
 
 /// Runs the study and writes its directory; missed targets are results, not errors.
