@@ -70,7 +70,18 @@ impl RunResult {
         let work = (self.particles * self.steps) as f64;
         self.cpu_s.filter(|_| work > 0.0).map(|cpu| cpu / work * 1e6)
     }
+
+    /// [`RunResult::core_us_per_particle_step`] over [`FLOOR_CORE_US_PER_PARTICLE_PASS`].
+    pub fn floor_ratio(&self) -> Option<f64> {
+        self.core_us_per_particle_step().map(|c| c / FLOOR_CORE_US_PER_PARTICLE_PASS)
+    }
 }
+
+/// The performance floor of NUMERICS.md as a CPU cost: one fused pair pass over the drop
+/// at Δx = 0.02 (7860 particles, 24 pairs each, ≈ 2.2 ns per pair) takes 0.42 ms on two
+/// threads, 0.107 core-µs per particle. A run's cost per particle-step over it is the
+/// number of such passes its step is worth.
+pub const FLOOR_CORE_US_PER_PARTICLE_PASS: f64 = 420.0 * 2.0 / 7860.0;
 
 /// The stable slug of a run: `<scheme>-<preset>_dx<dx>` (dx in shortest decimal form).
 pub fn slug(scheme: &str, preset: &str, dx: f64) -> String {

@@ -4,9 +4,11 @@
 //!
 //! CPU seconds are those of the threads that ran each run ([`crate::runner`]); a run's
 //! cost per particle-step is `cpu_s / (particles × steps)` in core-µs, which compares runs
-//! of any thread count. Times of cached runs are those measured when they ran.
+//! of any thread count, and its ratio to the floor of NUMERICS.md
+//! ([`FLOOR_CORE_US_PER_PARTICLE_PASS`]: one fused pair pass) says how many such passes a
+//! step is worth. Times of cached runs are those measured when they ran.
 
-use crate::results::{CaseResults, RunResult};
+use crate::results::{CaseResults, FLOOR_CORE_US_PER_PARTICLE_PASS, RunResult};
 use maud::{Markup, html};
 use std::fmt::Write;
 
@@ -77,7 +79,7 @@ fn rate(v: Option<f64>) -> String {
 
 /// The row cells of a run: case, run, threads, particles, steps, wall, CPU, steps/s,
 /// particle-steps/s, core-µs per particle-step.
-fn run_cells(case: &str, r: &RunResult) -> [String; 10] {
+fn run_cells(case: &str, r: &RunResult) -> [String; 11] {
     let steps_per_s = (r.wall_s > 0.0).then(|| r.steps as f64 / r.wall_s);
     [
         case.to_string(),
@@ -90,10 +92,11 @@ fn run_cells(case: &str, r: &RunResult) -> [String; 10] {
         opt(steps_per_s, 1),
         rate(r.particle_steps_per_s()),
         opt(r.core_us_per_particle_step(), 2),
+        opt(r.floor_ratio(), 1),
     ]
 }
 
-const RUN_HEADER: [&str; 10] = [
+const RUN_HEADER: [&str; 11] = [
     "case",
     "run",
     "threads",
@@ -104,11 +107,12 @@ const RUN_HEADER: [&str; 10] = [
     "steps/s",
     "particle-steps/s",
     "core-µs per particle-step",
+    "× floor",
 ];
 
 /// The cells of a case's (or the tier's) totals: runs, wall, CPU, particle-steps,
-/// particle-steps per wall second, core-µs per particle-step.
-fn total_cells(t: &Totals) -> [String; 6] {
+/// particle-steps per wall second, core-µs per particle-step and its ratio to the floor.
+fn total_cells(t: &Totals) -> [String; 7] {
     [
         t.runs.to_string(),
         format!("{:.1}", t.wall_s),
@@ -116,11 +120,19 @@ fn total_cells(t: &Totals) -> [String; 6] {
         format!("{:.3e}", t.particle_steps),
         rate((t.wall_s > 0.0).then(|| t.particle_steps / t.wall_s)),
         opt(t.core_us_per_particle_step(), 2),
+        opt(t.core_us_per_particle_step().map(|c| c / FLOOR_CORE_US_PER_PARTICLE_PASS), 1),
     ]
 }
 
-const TOTAL_HEADER: [&str; 6] =
-    ["runs", "wall [s]", "CPU [s]", "particle-steps", "particle-steps/s", "core-µs per particle-step"];
+const TOTAL_HEADER: [&str; 7] = [
+    "runs",
+    "wall [s]",
+    "CPU [s]",
+    "particle-steps",
+    "particle-steps/s",
+    "core-µs per particle-step",
+    "× floor",
+];
 
 fn tier_note(results: &[CaseResults], elapsed_s: Option<f64>) -> String {
     let t = Totals::of(results.iter().flat_map(|c| &c.runs));
@@ -142,7 +154,11 @@ pub fn html_section(results: &[CaseResults], elapsed_s: Option<f64>) -> Markup {
     html! {
         h2 { "Run time" }
         p { (tier_note(results, elapsed_s)) }
-        p class="note" { "CPU time: the threads that ran the run. A run's cost per particle-step is its CPU time over particles × steps (comparable across thread counts). Times of cached runs are those measured when they ran." }
+        p class="note" {
+            "CPU time: the threads that ran the run. A run's cost per particle-step is its CPU time over particles × steps (comparable across thread counts); × floor divides it by "
+            (format!("{FLOOR_CORE_US_PER_PARTICLE_PASS:.3}"))
+            " core-µs, one fused pair pass per particle at the floor of NUMERICS.md (2.2 ns per pair, 0.42 ms for the drop at Δx = 0.02 on two threads). Times of cached runs are those measured when they ran."
+        }
         table {
             tr { th class="l" { "case" } @for h in TOTAL_HEADER { th { (h) } } }
             @for c in results {
@@ -178,6 +194,10 @@ pub fn markdown_section(
 ) -> std::fmt::Result {
     writeln!(md, "\n## Run time\n")?;
     writeln!(md, "{}\n", tier_note(results, elapsed_s))?;
+    writeln!(
+        md,
+        "× floor: core-µs per particle-step over {FLOOR_CORE_US_PER_PARTICLE_PASS:.3}, one fused pair pass per particle (NUMERICS.md).\n"
+    )?;
     writeln!(md, "| case | {} |", TOTAL_HEADER.join(" | "))?;
     writeln!(md, "|---|{}", "---:|".repeat(TOTAL_HEADER.len()))?;
     for c in results {
@@ -245,6 +265,7 @@ mod tests {
         assert_eq!(cells[4], "50");
         assert_eq!(cells[8], "2.500e4", "particle-steps per wall second");
         assert_eq!(cells[9], "70.00", "core-µs per particle-step");
+        assert_eq!(cells[10], format!("{:.1}", 70.0 / FLOOR_CORE_US_PER_PARTICLE_PASS));
         let mut md = String::new();
         markdown_section(&mut md, &results, Some(12.0)).unwrap();
         assert!(md.contains("| **tier** | 3 | 7.0 | 7.3 | 2.050e5 |"), "{md}");

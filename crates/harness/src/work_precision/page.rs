@@ -2,6 +2,7 @@
 
 use super::channel::{ChannelRow, ChannelStudy};
 use super::record::{Cost, RunRow, Study};
+use crate::results::FLOOR_CORE_US_PER_PARTICLE_PASS;
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
 const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1250px;color:#222}\
@@ -50,7 +51,8 @@ fn run_row(r: &RunRow, front: bool) -> Markup {
 }
 
 /// The cells both studies' rows share: threads, particles, steps, wall time \[s\], CPU/wall,
-/// `ms` per step (formatted by the caller) and mean PPE iterations.
+/// `ms` per step (formatted by the caller), mean PPE iterations, core-µs per particle-step
+/// and its ratio to the floor ([`FLOOR_CORE_US_PER_PARTICLE_PASS`]).
 fn cost_cells(threads: usize, c: &Cost, ms: &str) -> Markup {
     html! {
         td { (threads) }
@@ -60,6 +62,8 @@ fn cost_cells(threads: usize, c: &Cost, ms: &str) -> Markup {
         td { (c.cpu_s.map_or("—".into(), |cpu| format!("{:.2}", cpu / c.wall_s.max(1e-12)))) }
         td { (ms) }
         td { (format!("{:.1}", c.ppe_iterations_mean)) }
+        td { (c.core_us_per_particle_step().map_or("—".into(), |u| format!("{u:.2}"))) }
+        td { (c.core_us_per_particle_step().map_or("—".into(), |u| format!("{:.1}", u / FLOOR_CORE_US_PER_PARTICLE_PASS))) }
     }
 }
 
@@ -102,7 +106,7 @@ fn channel_section(c: &ChannelStudy) -> Markup {
             tr {
                 th class="l" { "run" } th { "Δx" } th class="l" { "viscosity" } th class="l" { "shifting" } th class="l" { "PPE" }
                 th class="l" { "preset" } th { "threads" } th { "particles" } th { "steps" } th { "wall [s]" } th { "CPU/wall" }
-                th { "ms/step" } th { "PPE its" } th { "profile error (τ = 1)" } th { "start-up max" } th class="l" { "status" }
+                th { "ms/step" } th { "PPE its" } th { "core-µs per particle-step" } th { "× floor" } th { "profile error (τ = 1)" } th { "start-up max" } th class="l" { "status" }
             }
             @for r in &c.runs { (channel_row(r, c.pareto.contains(&r.id))) }
         }
@@ -156,7 +160,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                 p class="small" {
                     "Timings were taken on a shared machine (load average "
                     (m.loadavg_start.as_deref().unwrap_or("?")) " at the start, "
-                    (m.loadavg_end.as_deref().unwrap_or("?")) " at the end): compare them as ratios within one study. CPU/wall in the run table is the process CPU time over the wall time; well below the run's thread count, the run waited for the CPU."
+                    (m.loadavg_end.as_deref().unwrap_or("?")) " at the end): compare them as ratios within one study. CPU/wall in the run tables is the CPU time of the run's threads over its wall time; well below the run's thread count, the run waited for the CPU. Core-µs per particle-step is that CPU time over particles × steps, and × floor divides it by " (format!("{FLOOR_CORE_US_PER_PARTICLE_PASS:.3}")) " core-µs, one fused pair pass per particle at the floor of NUMERICS.md (2.2 ns per pair): how many such passes a step is worth."
                 }
                 h2 { "Figures" }
                 @for f in figures {
@@ -217,7 +221,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                     tr {
                         th class="l" { "run" } th { "Δx" } th class="l" { "PPE" } th class="l" { "gradient" } th class="l" { "divergence" }
                         th class="l" { "shifting" } th class="l" { "Δt" } th class="l" { "preset" } th { "threads" } th { "particles" }
-                        th { "steps" } th { "wall [s]" } th { "CPU/wall" } th { "ms/step" } th { "PPE its" } th { "b error (t = 0.008)" } th { "b error (max)" } th class="l" { "status" }
+                        th { "steps" } th { "wall [s]" } th { "CPU/wall" } th { "ms/step" } th { "PPE its" } th { "core-µs per particle-step" } th { "× floor" } th { "b error (t = 0.008)" } th { "b error (max)" } th class="l" { "status" }
                     }
                     @for r in &study.runs { (run_row(r, study.pareto.contains(&r.id))) }
                 }

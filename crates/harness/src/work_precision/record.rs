@@ -51,8 +51,8 @@ pub struct Cost {
     pub t_end: f64,
     /// Wall time of the stepping loop \[s\].
     pub wall_s: f64,
-    /// CPU time of the process (all threads) over the run \[s\], from `/proc/self/stat`:
-    /// `cpu_s / wall_s` well below the thread count means the machine was busy.
+    /// CPU time of the threads that ran the run \[s\] (Linux): `cpu_s / wall_s` well below
+    /// the thread count means the machine was busy.
     #[serde(default)]
     pub cpu_s: Option<f64>,
     /// Seconds per stage (the solver's `summary.json` `stages`, with `probes` and `guard`).
@@ -65,6 +65,12 @@ impl Cost {
     /// Wall time per step \[s\] (`None` before the first step).
     pub fn per_step(&self) -> Option<f64> {
         (self.steps > 0).then(|| self.wall_s / self.steps as f64)
+    }
+
+    /// CPU cost of one particle-step \[core-µs\] (none without a CPU time or a step).
+    pub fn core_us_per_particle_step(&self) -> Option<f64> {
+        let work = (self.particles * self.steps) as f64;
+        self.cpu_s.filter(|_| work > 0.0).map(|cpu| cpu / work * 1e6)
     }
 }
 
