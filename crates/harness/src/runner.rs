@@ -11,9 +11,9 @@
 //!   starts last while the other workers idle;
 //! - runs a *wide* job (one asking for every thread of the machine) alone, before the
 //!   others; the others `jobs` at a time, each worker with its own rayon pool of an equal
-//!   share of the threads (small runs, like the channels' few thousand particles, gain
-//!   nothing from a second thread: their steps are bound by synchronisation); a job may ask
-//!   for its own thread count instead (the work-precision study's thread counts);
+//!   share of the threads (a second thread speeds a run 1.5–1.8 times, a second run at once
+//!   doubles the throughput: docs/notes/main-job-time.md); a job may ask for its own thread
+//!   count instead (the work-precision study's thread counts);
 //! - measures each run's CPU time as the CPU time of the threads that ran it (the worker
 //!   and its pool), so it holds with several runs at once;
 //! - shows a bar per running run (simulated time) and, optionally, one for the batch whose
