@@ -243,7 +243,7 @@ pub struct Summary {
     pub expected_failures: usize,
     /// One entry per case, sorted by name.
     pub cases: Vec<CaseSummary>,
-    /// Wall time of the invocation that produced the results \[s\], when known.
+    /// Wall time of the last invocation that ran runs \[s\], when known.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub elapsed_s: Option<f64>,
 }

@@ -135,7 +135,15 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     let tally = runner.tally();
     (outcome.executed, outcome.reused) = (tally.executed, tally.reused);
     let extras = crate::stability::extra_page(&opts.out).into_iter().collect();
-    let elapsed_s = Some(started.elapsed().as_secs_f64());
+    // The wall time of the last invocation that ran something (a fully cached rerun keeps
+    // the previous one).
+    let elapsed_s = if tally.executed > 0 {
+        Some(started.elapsed().as_secs_f64())
+    } else {
+        io::read_json::<crate::results::Summary>(&opts.out.join("summary.json"))
+            .ok()
+            .and_then(|s| s.elapsed_s)
+    };
     let rendered =
         report::render(&opts.out, &RenderOptions { cases: Some(known), baseline, extras, elapsed_s })?;
     outcome.comparison = rendered.comparison;
@@ -400,8 +408,14 @@ mod tests {
             &CaseResults { case: "stale_case".into(), ..res.clone() },
         )
         .unwrap();
+        let timed: crate::results::Summary = io::read_json(&opts.out.join("summary.json")).unwrap();
         let second = validate(&opts).unwrap();
         assert_eq!((second.executed, second.reused), (0, 1));
+        let kept: crate::results::Summary = io::read_json(&opts.out.join("summary.json")).unwrap();
+        assert!(
+            timed.elapsed_s.is_some() && kept.elapsed_s == timed.elapsed_s,
+            "a cached rerun keeps the time"
+        );
         let index = std::fs::read_to_string(opts.out.join("index.html")).unwrap();
         assert!(index.contains("tiny_drop/index.html") && !index.contains("stale_case"));
         let summary: crate::results::Summary = io::read_json(&opts.out.join("summary.json")).unwrap();

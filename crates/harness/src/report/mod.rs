@@ -200,8 +200,8 @@ pub struct RenderOptions {
     pub baseline: Option<Baseline>,
     /// Pages beside the cases that the index links (the stability envelope's).
     pub extras: Vec<ExtraPage>,
-    /// Wall time of the invocation that produced the results \[s\] (shown beside the runs'
-    /// summed times).
+    /// Wall time of the last invocation that ran runs \[s\] (shown beside the runs' summed
+    /// times).
     pub elapsed_s: Option<f64>,
 }
 

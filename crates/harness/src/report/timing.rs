@@ -143,7 +143,7 @@ fn tier_note(results: &[CaseResults], elapsed_s: Option<f64>) -> String {
         cpu(&t)
     );
     if let Some(e) = elapsed_s {
-        let _ = write!(s, " This invocation took {e:.0} s wall (cached runs take none).");
+        let _ = write!(s, " The last invocation that ran runs took {e:.0} s wall.");
     }
     s
 }
