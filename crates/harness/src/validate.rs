@@ -152,7 +152,7 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
 
 /// Runs with at least this many particles get every thread of the machine (and run alone,
 /// first); smaller ones one worker's share. Measured on the 2-core machine
-/// (docs/notes/scheduling.md): a second thread speeds one run up 1.5–1.8 times (3200 to
+/// (docs/notes/main-job-time.md): a second thread speeds one run up 1.5–1.8 times (3200 to
 /// 96 000 particles), two one-thread runs at once give 2.0–2.2 times the throughput; so
 /// one thread per run wins, except for a run long enough to be the batch's critical path —
 /// the open channel at Δx = 0.0025 (96 000 particles), not the next largest (37 500).
