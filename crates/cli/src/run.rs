@@ -157,7 +157,7 @@ pub fn check(scene_path: &Path) -> anyhow::Result<()> {
     println!("  stages per step: {}", sim.stage_names().join(" -> "));
     println!(
         "  probes: {}",
-        scene.probes.iter().map(meniscus::probes::kind_name).collect::<Vec<_>>().join(", ")
+        scene.probes.iter().map(meniscus::scene::Probe::kind_name).collect::<Vec<_>>().join(", ")
     );
     Ok(())
 }

@@ -145,6 +145,7 @@ pub(crate) mod tests {
                 stages: BTreeMap::new(),
                 threads: 1,
                 ppe_iterations_mean: 3.0,
+                steady_at: None,
             },
             probes: CachedProbes {
                 t: vec![0.0, 1.0],

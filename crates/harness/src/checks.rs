@@ -410,6 +410,7 @@ mod tests {
             wall_s: 1.0,
             cpu_s: None,
             threads: None,
+            steady_at: None,
             status: status.into(),
             metrics: [("b_rel_err_max".to_string(), err)].into(),
             series: BTreeMap::new(),

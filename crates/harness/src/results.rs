@@ -26,6 +26,10 @@ pub struct RunResult {
     /// Threads it ran on (absent when not recorded).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub threads: Option<usize>,
+    /// When the steady-state stop (`time.steady`) ended the run before its end time: the
+    /// time \[s\] (absent otherwise).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steady_at: Option<f64>,
     /// `ok` or `diverged: <cause at step/time>`.
     pub status: String,
     /// Scalar metrics (non-finite values are written as `null`).
@@ -350,6 +354,7 @@ mod tests {
             wall_s: 0.1,
             cpu_s: None,
             threads: None,
+            steady_at: None,
             status: "diverged: x".into(),
             metrics: [("a".to_string(), f64::NAN)].into(),
             series: [("t".to_string(), vec![0.0, f64::INFINITY])].into(),

@@ -77,8 +77,16 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     let planned: Vec<(PathBuf, Vec<Job>)> = cases
         .iter()
         .map(|case| {
-            let jobs = sweep::expand(case, opts.tier)?.into_iter().map(plan).collect::<Result<_>>()?;
-            Ok((opts.out.join(&case.case), jobs))
+            let dir = opts.out.join(&case.case);
+            let measured = measured_costs(&dir);
+            let jobs = sweep::expand(case, opts.tier)?
+                .into_iter()
+                .map(|spec| {
+                    let previous = measured.get(&spec.slug).copied();
+                    plan(spec, previous)
+                })
+                .collect();
+            Ok((dir, jobs))
         })
         .collect::<Result<_>>()?;
     let placed: Vec<(&Path, &Job)> =
@@ -159,21 +167,44 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
 pub const WIDE_PARTICLES: usize = 50_000;
 
 /// Estimated cost of one particle-step \[core-s\] (the paper drop at Δx = 0.02: about
-/// 1.5 core-µs): scales the estimate of [`plan`] to seconds for the progress bar's ETA.
+/// 1.5 core-µs): scales the estimate of [`plan`] to core-seconds when no run measured it.
 const CORE_S_PER_PARTICLE_STEP: f64 = 1.5e-6;
 
 /// The job of a run: its thread count from its particle count ([`WIDE_PARTICLES`]) and its
-/// estimated cost, `particles × end / Δt₀ × 1.5 core-µs` with the first step's Δt (built
-/// from the scene before anything runs; a scene that cannot start is costed as zero, and
-/// its error is the run's).
-fn plan(spec: RunSpec) -> Result<Job> {
-    let (particles, steps) = match meniscus::AnySimulation::new(&spec.scene) {
-        Ok(sim) => (sim.particles(), sim.first_step().map_or(0.0, |dt| (spec.scene.time.end / dt).ceil())),
-        Err(_) => (0, 0.0),
+/// cost in core-seconds: `previous`, the same run's measured cost when the case's last
+/// results have it; otherwise `particles × end / Δt₀ × 1.5 core-µs` with the first step's
+/// Δt (built from the scene before anything runs; a scene that cannot start is costed as
+/// zero, and its error is the run's). The estimate ranks a flow that starts from rest by
+/// its first, viscous-limited step, ten times too cheap for the periodic channel at Re 400
+/// (docs/notes/main-job-time.md); a measured cost ranks it right.
+fn plan(spec: RunSpec, previous: Option<f64>) -> Job {
+    let Ok(sim) = meniscus::AnySimulation::new(&spec.scene) else {
+        return Job::new(spec);
     };
+    let particles = sim.particles();
     let threads = (particles >= WIDE_PARTICLES).then(rayon::current_num_threads);
-    let cost = particles as f64 * steps * CORE_S_PER_PARTICLE_STEP;
-    Ok(Job { threads, cost, ..Job::new(spec) })
+    let cost = previous.unwrap_or_else(|| {
+        let steps = sim.first_step().map_or(0.0, |dt| (spec.scene.time.end / dt).ceil());
+        particles as f64 * steps * CORE_S_PER_PARTICLE_STEP
+    });
+    Job { threads, cost, ..Job::new(spec) }
+}
+
+/// The core-seconds each run of a case took when it last ran, by slug, from the case's
+/// `results.json` in `dir` (CPU time when measured, else wall time × threads); empty when
+/// there is no readable results file.
+fn measured_costs(dir: &Path) -> BTreeMap<String, f64> {
+    let Ok(previous) = io::read_json::<CaseResults>(&dir.join("results.json")) else {
+        return BTreeMap::new();
+    };
+    previous
+        .runs
+        .iter()
+        .filter_map(|r| {
+            let core_s = r.cpu_s.unwrap_or(r.wall_s * r.threads.unwrap_or(1) as f64);
+            (core_s > 0.0 && core_s.is_finite()).then(|| (r.slug(), core_s))
+        })
+        .collect()
 }
 
 /// A run of `case` as its results file shows it: the metrics of its probes against the
@@ -188,6 +219,7 @@ pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
         wall_s: 0.0,
         cpu_s: None,
         threads: None,
+        steady_at: None,
         status: ran.status(),
         metrics: BTreeMap::new(),
         series: BTreeMap::new(),
@@ -197,7 +229,7 @@ pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
         let measured = metrics::compute(&case.reference, &r.scene, &probes, r.summary.particles)
             .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
         (run.particles, run.steps, run.wall_s) = (r.summary.particles, r.summary.steps, r.summary.wall_s);
-        (run.cpu_s, run.threads) = (r.cpu_s, r.threads);
+        (run.cpu_s, run.threads, run.steady_at) = (r.cpu_s, r.threads, r.summary.steady_at);
         (run.metrics, run.series) = (measured.metrics, measured.series);
     }
     Ok(run)
@@ -309,6 +341,23 @@ mod tests {
             .into(),
         };
         rec
+    }
+
+    #[test]
+    fn measured_costs_come_from_the_last_results() {
+        let dir = Scratch::new("measured-costs");
+        assert!(measured_costs(dir.path()).is_empty(), "no results file: no measured cost");
+        let mut timed = synthetic("paper", 0.04, 5.0, 1976);
+        (timed.summary.wall_s, timed.cpu_s) = (3.0, Some(5.5));
+        let mut untimed = synthetic("paper", 0.02, 5.0, 7860);
+        (untimed.summary.wall_s, untimed.threads) = (2.0, Some(2));
+        let mut unknown = synthetic("tuned", 0.02, 1.0, 7860);
+        unknown.summary.wall_s = 0.0;
+        io::write_json(&dir.path().join("results.json"), &results(vec![timed, untimed, unknown])).unwrap();
+        let costs = measured_costs(dir.path());
+        assert_eq!(costs.len(), 2, "{costs:?}");
+        assert!((costs["isph-paper_dx0.04"] - 5.5).abs() < 1e-12, "CPU time when measured");
+        assert!((costs["isph-paper_dx0.02"] - 4.0).abs() < 1e-12, "else wall time x threads");
     }
 
     #[test]

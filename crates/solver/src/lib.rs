@@ -31,6 +31,7 @@ pub mod setup;
 pub mod stage;
 pub mod stages;
 pub mod state;
+pub mod steady;
 pub mod time_step;
 pub mod warm_pool;
 pub mod wcsph;

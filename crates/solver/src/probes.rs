@@ -61,17 +61,8 @@ pub struct ProbeSet<const D: usize> {
 impl<const D: usize> ProbeSet<D> {
     /// Probes of a scene; repeated kinds get `_1`, `_2`, ... suffixes.
     pub fn new(probes: &[Probe], weight: Weight, dx: f64, domain: Domain<D>) -> Self {
-        let mut seen: BTreeMap<&'static str, usize> = BTreeMap::new();
-        let probes: Vec<(String, Probe)> = probes
-            .iter()
-            .map(|p| {
-                let base = kind_name(p);
-                let k = seen.entry(base).or_insert(0);
-                let key = if *k == 0 { base.to_string() } else { format!("{base}_{k}") };
-                *k += 1;
-                (key, p.clone())
-            })
-            .collect();
+        let probes: Vec<(String, Probe)> =
+            crate::scene::probe_keys(probes).into_iter().zip(probes.iter().cloned()).collect();
         let search = probes
             .iter()
             .any(|(_, p)| matches!(p, Probe::Disorder {}))
@@ -259,20 +250,4 @@ fn count_clusters(list: &NeighbourList, n: usize, parent: &mut Vec<u32>) -> usiz
         }
     }
     (0..n).filter(|&a| root(parent, a) == a).count()
-}
-
-/// Output key of a probe kind.
-pub fn kind_name(p: &Probe) -> &'static str {
-    match p {
-        Probe::EllipseAxes {} => "ellipse_axes",
-        Probe::PressureAt { .. } => "pressure_at",
-        Probe::KineticEnergy {} => "kinetic_energy",
-        Probe::Momentum {} => "momentum",
-        Probe::Disorder {} => "disorder",
-        Probe::Solver {} => "solver",
-        Probe::VelocityProfile { .. } => "velocity_profile",
-        Probe::MassBalance {} => "mass_balance",
-        Probe::MaxSpeed {} => "max_speed",
-        Probe::DropShape {} => "drop_shape",
-    }
 }

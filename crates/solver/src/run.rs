@@ -13,6 +13,7 @@ use crate::scene::{Scene, TimeStep};
 use crate::scheme::{Adaptive, Method, SavedState, Scheme};
 use crate::stage::StepContext;
 use crate::state::State;
+use crate::steady::is_steady;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 use std::time::Instant;
@@ -41,6 +42,10 @@ pub struct Summary {
     pub threads: usize,
     /// Mean PPE iterations per step.
     pub ppe_iterations_mean: f64,
+    /// When the steady-state stop (`time.steady`) ended the run: the time \[s\] (equal to
+    /// `t_end`); absent when the run went to its end time or diverged.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steady_at: Option<f64>,
 }
 
 /// How a run ended (`summary.json`'s `status`).
@@ -267,7 +272,7 @@ impl<const D: usize> Simulation<D> {
         if vtk_every > 0 {
             observer.frame(&self.frame(0, 0.0));
         }
-        let mut error = None;
+        let (mut error, mut steady_at) = (None, None);
         // Requested probe times: steps are shortened to land on them.
         let targets = self.scene.output.probe_times.clone();
         let mut next = targets.iter().take_while(|&&s| s <= 0.0).count();
@@ -311,15 +316,24 @@ impl<const D: usize> Simulation<D> {
                 snapshots.push(self.frame(step, t));
                 next_snap += 1;
             }
+            let mut steady = false;
             if step % every == 0 || last || hit {
                 let s0 = Instant::now();
                 self.probes.record(self.method.state(), t, &mut record);
+                steady = !last && self.scene.time.steady.as_ref().is_some_and(|s| is_steady(s, &record));
                 t_probes += s0.elapsed().as_secs_f64();
             }
             if vtk_every > 0 && (step % vtk_every == 0 || last) {
                 observer.frame(&self.frame(step, t));
             }
             observer.progress(step, t, t_end);
+            if steady {
+                steady_at = Some(t);
+                if vtk_every > 0 && step % vtk_every != 0 {
+                    observer.frame(&self.frame(step, t));
+                }
+                break;
+            }
         }
         let wall_s = start.elapsed().as_secs_f64();
         let mut stages = BTreeMap::new();
@@ -339,6 +353,7 @@ impl<const D: usize> Simulation<D> {
             stages,
             threads,
             ppe_iterations_mean: ppe_iters as f64 / step.max(1) as f64,
+            steady_at,
         };
         let last_good = error.as_ref().map(|_| self.last_good_frame());
         RunReport { summary, probes: record, final_frame: self.frame(step, t), error, last_good, snapshots }

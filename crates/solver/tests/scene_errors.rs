@@ -17,6 +17,11 @@ fn design_example_parses_unchanged() {
     assert_eq!(s.name, "elliptical_drop");
 }
 
+/// A `time.steady` block (the drop scene ends at 8 ms).
+fn steady(probe: &str, window: f64, tolerance: f64, after: f64) -> Value {
+    json!({"probe": probe, "window": window, "tolerance": tolerance, "after": after})
+}
+
 #[test]
 fn each_invalid_field_is_named() {
     type Edit = Box<dyn FnOnce(&mut Value)>;
@@ -53,6 +58,13 @@ fn each_invalid_field_is_named() {
             Box::new(|v| v["scheme"]["isph"]["shifting"]["xu"]["coefficient"] = json!(-0.02)),
         ),
         ("output.probe_every", Box::new(|v| v["output"]["probe_every"] = json!(0))),
+        (
+            "time.steady.probe",
+            Box::new(|v| v["time"]["steady"] = steady("velocity_profile", 1e-3, 0.01, 0.0)),
+        ),
+        ("time.steady.window", Box::new(|v| v["time"]["steady"] = steady("ellipse_axes", 4e-3, 0.01, 0.0))),
+        ("time.steady.tolerance", Box::new(|v| v["time"]["steady"] = steady("ellipse_axes", 1e-3, 0.0, 0.0))),
+        ("time.steady.after", Box::new(|v| v["time"]["steady"] = steady("ellipse_axes", 1e-3, 0.01, 0.008))),
         ("dx", Box::new(|v| v["dx"] = json!(1e-5))),
         ("kernel.h_over_dx", Box::new(|v| v["kernel"]["h_over_dx"] = json!(0.5))),
         ("fluid", Box::new(|v| v["fluid"]["colour"] = json!(1))),

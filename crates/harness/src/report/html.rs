@@ -305,7 +305,11 @@ pub fn case_page(
             @for r in &results.runs {
                 tr {
                     td class="l" { code { (r.slug()) } }
-                    @if r.ok() { td class="l pass" { "ok" } } @else { td class="l fail" { (r.status) } }
+                    @if r.ok() {
+                        td class="l pass" {
+                            "ok" @if let Some(t) = r.steady_at { " (steady at t = " (format!("{t:.4e}")) " s)" }
+                        }
+                    } @else { td class="l fail" { (r.status) } }
                     td { (r.particles) } td { (r.steps) } td { (format!("{:.2}", r.wall_s)) }
                     @for m in &columns { td { (format_metric(m, r.metric(m))) } }
                 }

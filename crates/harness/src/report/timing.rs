@@ -229,6 +229,7 @@ mod tests {
             wall_s,
             cpu_s,
             threads: Some(2),
+            steady_at: None,
             status: "ok".into(),
             metrics: BTreeMap::new(),
             series: BTreeMap::new(),

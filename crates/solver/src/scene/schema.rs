@@ -613,13 +613,40 @@ pub enum PressureGradient {
 }
 
 /// End time and time-step rule.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TimeSpec {
     /// End time \[s\].
     pub end: f64,
     /// Step rule.
     pub step: TimeStep,
+    /// Stop before `end` once the flow is steady (absent: run to `end`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steady: Option<SteadyStop>,
+}
+
+/// A steady-state stop (`time.steady`): after each probe sample at `t ≥ max(after,
+/// 2 window)`, the mean of every selected quantity of one probe over the last `window`
+/// seconds, `m₁`, is compared with its mean over the `window` before, `m₀`; the run ends
+/// (as reached) at the first sample where `‖m₁ − m₀‖₂ ≤ tolerance ‖m₁‖₂` over the selected
+/// quantities. Two window means, not two samples, because a particle sample is noisy; a
+/// non-finite mean (an empty bin) means "not steady".
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SteadyStop {
+    /// Output key of the probe (`velocity_profile_1`: the second `velocity_profile`).
+    pub probe: String,
+    /// Quantities of the probe compared: those whose name starts with this (`u_`: the
+    /// velocity bins of a profile); all of them when absent.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quantities: Option<String>,
+    /// Averaging window \[s\].
+    pub window: f64,
+    /// Relative change of the window means at which the flow counts as steady.
+    pub tolerance: f64,
+    /// No stop before this time \[s\] (e.g. before the flow can have reached the probe).
+    #[serde(default)]
+    pub after: f64,
 }
 
 /// Time-step rule.
@@ -744,6 +771,40 @@ impl Default for OutputSpec {
 
 fn default_probe_every() -> usize {
     10
+}
+
+/// Output keys of a scene's probes, in order: the kind's name, with `_1`, `_2`, ... for
+/// repeated kinds (`velocity_profile`, `velocity_profile_1`).
+pub fn probe_keys(probes: &[Probe]) -> Vec<String> {
+    let mut seen: std::collections::BTreeMap<&'static str, usize> = Default::default();
+    probes
+        .iter()
+        .map(|p| {
+            let base = p.kind_name();
+            let k = seen.entry(base).or_insert(0);
+            let key = if *k == 0 { base.to_string() } else { format!("{base}_{k}") };
+            *k += 1;
+            key
+        })
+        .collect()
+}
+
+impl Probe {
+    /// Output key of the probe's kind (`probes.json`).
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Probe::EllipseAxes {} => "ellipse_axes",
+            Probe::PressureAt { .. } => "pressure_at",
+            Probe::KineticEnergy {} => "kinetic_energy",
+            Probe::Momentum {} => "momentum",
+            Probe::Disorder {} => "disorder",
+            Probe::Solver {} => "solver",
+            Probe::VelocityProfile { .. } => "velocity_profile",
+            Probe::MassBalance {} => "mass_balance",
+            Probe::MaxSpeed {} => "max_speed",
+            Probe::DropShape {} => "drop_shape",
+        }
+    }
 }
 
 #[cfg(test)]

@@ -142,6 +142,9 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
             }
         }
     }
+    if let Some(steady) = &scene.time.steady {
+        validate_steady(steady, scene)?;
+    }
     for (i, probe) in scene.probes.iter().enumerate() {
         if let Probe::PressureAt { point } = probe {
             vector(&format!("probes[{i}].pressure_at.point"), point, d)?;
@@ -394,6 +397,37 @@ fn validate_body(f: &str, body: &Body, d: usize, dx: f64) -> Result<(), SceneErr
         InitialPressure::Hydrostatic { surface_point } => {
             vector(&format!("{f}.pressure.hydrostatic.surface_point"), surface_point, d)?;
         }
+    }
+    Ok(())
+}
+
+/// `time.steady`: a probe of the scene, a window of which two fit before the end, a
+/// positive tolerance and a start before the end.
+fn validate_steady(steady: &SteadyStop, scene: &Scene) -> Result<(), SceneError> {
+    let keys = probe_keys(&scene.probes);
+    if !keys.contains(&steady.probe) {
+        return Err(SceneError::new(
+            "time.steady.probe",
+            &steady.probe,
+            format!("must be the output key of one of the scene's probes ({})", keys.join(", ")),
+        ));
+    }
+    positive("time.steady.window", steady.window)?;
+    if 2.0 * steady.window >= scene.time.end {
+        return Err(SceneError::new(
+            "time.steady.window",
+            steady.window,
+            format!("must be less than half of time.end = {} (two windows are compared)", scene.time.end),
+        ));
+    }
+    positive("time.steady.tolerance", steady.tolerance)?;
+    non_negative("time.steady.after", steady.after)?;
+    if steady.after >= scene.time.end {
+        return Err(SceneError::new(
+            "time.steady.after",
+            steady.after,
+            format!("must be less than time.end = {}", scene.time.end),
+        ));
     }
     Ok(())
 }
