@@ -96,20 +96,12 @@ pub fn spec(case: &Case, preset: &str, dx: f64) -> Result<RunSpec> {
     RunSpec::from_json(&case.case, slug(&scheme, preset, dx), preset, dx, &value)
 }
 
-/// SHA-256 of the running executable (which contains the solver), computed once: any
-/// change of the solver's code gives a new build and so invalidates cached runs. Falls back
-/// to the harness version when the executable cannot be read.
+/// The solver's fingerprint (SHA-256 of its sources, manifest, `Cargo.lock` and the
+/// compiler version; `build.rs`): any change of the solver's code invalidates cached runs,
+/// a change of the harness alone (metrics, checks, reports) does not — the records hold the
+/// runs' probes, from which the harness recomputes everything.
 pub fn build_fingerprint() -> &'static str {
-    static FINGERPRINT: std::sync::OnceLock<String> = std::sync::OnceLock::new();
-    FINGERPRINT.get_or_init(|| {
-        std::env::current_exe()
-            .and_then(std::fs::read)
-            .map(|bytes| {
-                use sha2::{Digest, Sha256};
-                Sha256::digest(&bytes).iter().map(|b| format!("{b:02x}")).collect()
-            })
-            .unwrap_or_else(|_| format!("meniscus-harness {}", env!("CARGO_PKG_VERSION")))
-    })
+    env!("MENISCUS_SOLVER_FINGERPRINT")
 }
 
 /// Every run of `case` in `tier`: spacings from coarse to fine, presets in file order.
@@ -182,6 +174,13 @@ mod tests {
         let mut changed = c.clone();
         changed.scene["time"]["end"] = serde_json::json!(0.004);
         assert_ne!(a.hash, spec(&changed, "paper", 0.04).unwrap().hash);
+    }
+
+    #[test]
+    fn the_fingerprint_is_a_sha256_of_the_solver() {
+        let f = build_fingerprint();
+        assert_eq!(f.len(), 64, "{f}");
+        assert!(f.bytes().all(|b| b.is_ascii_hexdigit()), "{f}");
     }
 
     #[test]
