@@ -310,6 +310,7 @@ impl Case {
         }
         for c in &self.checks {
             c.validate().map_err(|m| err(format!("check `{}`: {m}", c.display_name())))?;
+            self.check_selector(c).map_err(|m| err(format!("check `{}`: {m}", c.display_name())))?;
             for (field, v) in [("study", &c.select.study), ("case", &c.select.case)] {
                 if let Some(v) = v {
                     return Err(err(format!(
@@ -320,6 +321,62 @@ impl Case {
             }
         }
         Ok(())
+    }
+}
+
+impl Case {
+    /// A check's selector names what the sweep runs: a preset of the case, one of its
+    /// spacings, a scheme of its presets; and each tier the check lists runs what it
+    /// selects. (A misspelt selector would match nothing and the check would vanish.)
+    fn check_selector(&self, c: &CheckSpec) -> std::result::Result<(), String> {
+        let sel = &c.select;
+        let names: Vec<&str> = self.sweep.presets.iter().map(|p| p.name.as_str()).collect();
+        if let Some(p) = &sel.preset
+            && !names.contains(&p.as_str())
+        {
+            return Err(format!(
+                "`select.preset` = {p:?} is not a preset of the case ({})",
+                names.join(", ")
+            ));
+        }
+        let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs();
+        if let Some(d) = sel.dx
+            && !self.sweep.dx.values().flatten().any(|&s| same(s, d))
+        {
+            return Err(format!("`select.dx` = {d} is not a spacing of `sweep.dx`"));
+        }
+        let schemes: Vec<String> = self.sweep.presets.iter().map(|p| self.preset_scheme(p)).collect();
+        if let Some(s) = &sel.scheme
+            && !schemes.contains(s)
+        {
+            return Err(format!(
+                "`select.scheme` = {s:?} is not a scheme of the presets ({})",
+                schemes.join(", ")
+            ));
+        }
+        for &tier in c.tiers.iter().flatten() {
+            if let Some(p) = &sel.preset
+                && !self.presets(tier).any(|q| q.name == *p)
+            {
+                return Err(format!("lists tier `{tier}`, in which preset {p:?} does not run"));
+            }
+            if let Some(d) = sel.dx
+                && !self.spacings(tier).iter().any(|&s| same(s, d))
+            {
+                return Err(format!("lists tier `{tier}`, whose spacings do not include {d}"));
+            }
+        }
+        Ok(())
+    }
+
+    /// The scheme a preset runs: the key of the scene's `scheme` once the preset's patch
+    /// is merged (as `sweep::spec` names it), else the case's.
+    fn preset_scheme(&self, p: &Preset) -> String {
+        let mut scheme = self.scene.get("scheme").cloned().unwrap_or_default();
+        if let Some(patch) = p.patch.get("scheme") {
+            crate::patch::merge_patch(&mut scheme, patch);
+        }
+        scheme.as_object().and_then(|m| m.keys().next().cloned()).unwrap_or_else(|| self.scheme.clone())
     }
 }
 
@@ -411,5 +468,29 @@ mod tests {
         v["checks"][0]["select"]["study"] = "dt_max".into();
         let e = Case::from_json(&v.to_string(), Path::new("x.json")).unwrap_err();
         assert!(e.to_string().contains("`select.study` = \"dt_max\""), "{e}");
+    }
+
+    /// A selector that could match nothing is rejected when the case loads, naming the
+    /// check: a misspelt preset, a spacing or scheme the sweep does not have, a tier in
+    /// which the selected preset or spacing does not run.
+    #[test]
+    fn selectors_name_what_the_sweep_runs() {
+        let error = |edit: &dyn Fn(&mut serde_json::Value)| {
+            let mut v = serde_json::to_value(repo_case()).unwrap();
+            v["checks"][0] = serde_json::json!({"name": "the check", "metric": "b_rel_err_max", "max": 0.01});
+            edit(&mut v["checks"][0]);
+            Case::from_json(&v.to_string(), Path::new("x.json")).err().map(|e| e.to_string())
+        };
+        assert_eq!(error(&|_| {}), None);
+        assert_eq!(error(&|c| c["select"] = serde_json::json!({"preset": "tuned", "dx": 0.02})), None);
+        for (edit, says) in [
+            (serde_json::json!({"select": {"preset": "paperr"}}), "`select.preset` = \"paperr\""),
+            (serde_json::json!({"select": {"dx": 0.03}}), "`select.dx` = 0.03"),
+            (serde_json::json!({"select": {"scheme": "mps"}}), "`select.scheme` = \"mps\""),
+            (serde_json::json!({"select": {"dx": 0.005}, "tiers": ["quick"]}), "tier `quick`"),
+        ] {
+            let e = error(&|c| crate::patch::merge_patch(c, &edit)).unwrap_or_default();
+            assert!(e.contains("the check") && e.contains(says), "{edit}: {e}");
+        }
     }
 }

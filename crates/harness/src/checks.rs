@@ -235,17 +235,36 @@ impl CheckSpec {
         }
     }
 
-    /// Evaluates the check on the rows of `tier`; `None` when it does not apply (no row
-    /// selected, another tier, or fewer than two spacings for `decreasing`/`order`).
+    /// Evaluates the check on the rows of `tier`; `None` when it does not apply: another
+    /// tier, a selected preset, spacing or scheme that none of the rows has (it does not
+    /// run in this tier), or a single spacing for `decreasing`/`order`. A check that
+    /// applies but selects no row fails ("no run matches"): absent data never passes.
     pub fn evaluate<R: Checked>(&self, rows: &[R], tier: Tier) -> Option<CheckResult> {
         if !self.applies(tier) {
             return None;
         }
         let picked: Vec<&R> = rows.iter().filter(|r| self.select.matches(*r)).collect();
-        if picked.is_empty() {
-            return None;
-        }
         let name = self.display_name();
+        if picked.is_empty() {
+            let sel = &self.select;
+            let runs_here = |pick: &dyn Fn(&RunResult) -> bool| rows.iter().any(|r| pick(r.run()));
+            let in_tier = sel.preset.as_ref().is_none_or(|p| runs_here(&|r| r.preset == *p))
+                && sel.dx.is_none_or(|d| runs_here(&|r| (r.dx - d).abs() <= 1e-9 * d.abs()))
+                && sel.scheme.as_ref().is_none_or(|s| runs_here(&|r| r.scheme == *s));
+            if !in_tier {
+                return None;
+            }
+            return Some(CheckResult {
+                name,
+                value: None,
+                threshold: self.threshold(),
+                pass: false,
+                note: Some(self.missing.clone().unwrap_or_else(|| {
+                    format!("no run matches the selector{} in tier {tier}", sel.describe())
+                })),
+                expected_failure: self.expected_failure.clone(),
+            });
+        }
         let diverged: Vec<String> = picked.iter().filter_map(|r| r.failure()).collect();
         let selected: Vec<&RunResult> = picked.iter().map(|r| r.run()).collect();
         let (metric, missing) = (self.metric.as_str(), self.missing.as_deref());
@@ -371,8 +390,19 @@ fn order(name: &str, runs: &[&RunResult], metric: &str, min: f64) -> Option<Chec
         applicable = true;
         let dx: Vec<f64> = pts.iter().map(|p| p.0).collect();
         let e: Vec<f64> = pts.iter().map(|p| p.1.unwrap_or(f64::NAN)).collect();
+        // Every spacing's point or no verdict: a fit through the points that happen to be
+        // there would judge less than was asked.
         match fit_power_law(&dx, &e) {
-            Some(fit) => worst = Some(worst.map_or(fit.order, |w| w.min(fit.order))),
+            Some(fit) if fit.points == pts.len() => {
+                worst = Some(worst.map_or(fit.order, |w| w.min(fit.order)))
+            }
+            Some(fit) => {
+                note = Some(format!(
+                    "`{metric}` missing, not finite or not positive in {scheme}-{preset}: {} of {} spacings",
+                    fit.points,
+                    pts.len()
+                ))
+            }
             None => note = Some(format!("no order could be fitted for {scheme}-{preset}")),
         }
     }
@@ -471,6 +501,34 @@ mod tests {
             serde_json::from_value(json!({"metric": "b_rel_err_max", "max": 0.01, "expected_failure": " "}))
                 .unwrap();
         assert!(empty.validate().unwrap_err().contains("expected_failure"));
+    }
+
+    /// Absent data never passes: a check that applies but selects no run fails; one whose
+    /// preset does not run in the tier does not apply; an order fit short of a spacing
+    /// fails.
+    #[test]
+    fn absent_data_fails() {
+        let rows = vec![run("paper", 0.04, 0.02, 1976, "ok"), run("tuned", 0.02, 0.012, 7860, "ok")];
+        let nothing =
+            spec(json!({"metric": "b_rel_err_max", "select": {"preset": "paper", "dx": 0.02}, "max": 1.0}));
+        let r = nothing.evaluate(&rows, Tier::Quick).expect("applies: preset and spacing run here");
+        assert!(!r.pass && r.value.is_none());
+        assert!(r.note.as_deref().is_some_and(|n| n.contains("no run matches")), "{:?}", r.note);
+        let elsewhere = spec(json!({"metric": "b_rel_err_max", "select": {"preset": "wcsph"}, "max": 1.0}));
+        assert!(elsewhere.evaluate(&rows, Tier::Quick).is_none(), "the preset does not run in this tier");
+        let mut three = vec![
+            run("paper", 0.04, 0.04, 1976, "ok"),
+            run("paper", 0.02, 0.01, 7860, "ok"),
+            run("paper", 0.01, 0.0025, 31000, "ok"),
+        ];
+        let order = spec(json!({"metric": "b_rel_err_max", "kind": "order", "min": 1.5}));
+        assert!(order.evaluate(&three, Tier::Quick).unwrap().pass);
+        three[1].metrics.clear();
+        let r = order.evaluate(&three, Tier::Quick).unwrap();
+        assert!(!r.pass, "two of three points fitted: {r:?}");
+        assert!(r.note.as_deref().is_some_and(|n| n.contains("2 of 3 spacings")), "{:?}", r.note);
+        three[1].metrics.insert("b_rel_err_max".into(), f64::NAN);
+        assert!(!order.evaluate(&three, Tier::Quick).unwrap().pass, "a NaN point");
     }
 
     #[test]

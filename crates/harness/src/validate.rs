@@ -238,7 +238,18 @@ pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
 /// Builds a case's results from its runs: orders and checks.
 pub fn assemble(case: &Case, tier: Tier, runs: Vec<RunResult>) -> CaseResults {
     let convergence = convergence(case, &runs);
-    let checks = evaluate_all(&case.checks, &runs, tier);
+    let mut checks = evaluate_all(&case.checks, &runs, tier);
+    if checks.is_empty() {
+        // A case that nothing judges cannot fail: it reads as a failure, not "0 / 0".
+        checks.push(crate::results::CheckResult {
+            name: format!("at least one check applies in tier {tier}"),
+            value: None,
+            threshold: None,
+            pass: false,
+            note: Some(format!("no check of {} selects a run of tier {tier}", case.case)),
+            expected_failure: None,
+        });
+    }
     CaseResults {
         case: case.case.clone(),
         scheme: case.scheme.clone(),
@@ -343,6 +354,19 @@ mod tests {
         rec
     }
 
+    /// A case that no check judges in a tier fails there instead of reading "0 / 0".
+    #[test]
+    fn a_case_with_no_applicable_check_fails() {
+        let mut case = drop_case();
+        case.checks.retain(|c| c.select.preset.as_deref() == Some("wcsph_paper"));
+        assert!(!case.checks.is_empty());
+        let runs = results(vec![synthetic("paper", 0.04, 5.0, 1976)]).runs;
+        let res = assemble(&case, Tier::Quick, runs);
+        assert_eq!(res.checks.len(), 1, "{:?}", res.checks);
+        assert!(!res.checks[0].pass && res.checks[0].name.contains("at least one check"));
+        assert!(!res.pass());
+    }
+
     #[test]
     fn measured_costs_come_from_the_last_results() {
         let dir = Scratch::new("measured-costs");
@@ -428,6 +452,11 @@ mod tests {
         case.scene["output"]["probe_every"] = serde_json::json!(5);
         case.sweep.dx = [(Tier::Quick, vec![0.1])].into();
         case.sweep.presets.truncate(1);
+        // The checks of what the tiny case still runs (a selector naming a preset or a
+        // spacing it no longer has is rejected when the case loads).
+        case.checks
+            .retain(|c| c.select.preset.as_deref().is_none_or(|p| p == "paper") && c.select.dx.is_none());
+        assert!(!case.checks.is_empty());
         io::write_json(&vdir.join("tiny_drop.json"), &case).unwrap();
         let opts = ValidateOptions {
             tier: Tier::Quick,

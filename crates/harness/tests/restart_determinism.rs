@@ -38,6 +38,11 @@ fn restarted_sweep_reproduces_results_bit_for_bit() {
     // The two ISPH presets (the file also has the WCSPH ones).
     case.sweep.presets.truncate(2);
     assert_eq!(case.sweep.presets.len(), 2);
+    // The checks of what the tiny case still runs (a selector naming a preset or spacing it
+    // no longer has is rejected when the case loads).
+    let kept = ["paper", "tuned"];
+    case.checks
+        .retain(|c| c.select.preset.as_deref().is_none_or(|p| kept.contains(&p)) && c.select.dx.is_none());
     std::fs::write(
         dir.join("validation/restart_drop.json"),
         serde_json::to_string_pretty(&case).expect("case JSON"),

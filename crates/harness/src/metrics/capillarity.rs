@@ -24,7 +24,7 @@
 //!   `a_extent` (the x half-extent) against mode 4, `ω² = 60 σ/(ρR³)`, from the mean spacing
 //!   of its crossings of its own mean over the second half of the run.
 
-use super::Measured;
+use super::{Measured, nan_max, sticky_max};
 use meniscus::ProbeRecord;
 use meniscus_reference::ReferenceError;
 use meniscus_reference::capillarity::{self, Dimension};
@@ -184,7 +184,7 @@ pub fn compute(case: &Capillary, probes: &ProbeRecord) -> Result<Measured, Refer
                     .iter()
                     .zip(&d)
                     .filter(|(x, _)| **x <= t[0] + period_ref)
-                    .fold(0.0_f64, |m, (_, y)| m.max(y.abs()));
+                    .fold(0.0_f64, |m, (_, y)| sticky_max(m, y.abs()));
                 let band = HYSTERESIS * scale;
                 let c = crossings_with_hysteresis(t, &d, 0.0, band);
                 let period = period_from_crossings(&c);
@@ -220,7 +220,7 @@ pub fn compute(case: &Capillary, probes: &ProbeRecord) -> Result<Measured, Refer
             let r = capillarity::equivalent_radius_of_square(Dimension::Two, side)?;
             pressure(capillarity::laplace_pressure(Dimension::Two, sigma, r)?, m);
             if let Some(c) = probes.get("drop_shape", "clusters") {
-                m.insert("clusters_max".into(), c.iter().copied().fold(0.0, f64::max));
+                m.insert("clusters_max".into(), nan_max(c));
                 out.series.insert("clusters".into(), c.to_vec());
             }
             if let Some(rm) = probes.get("drop_shape", "r_max") {

@@ -137,7 +137,7 @@ pub fn compute(ch: &Channel, probes: &ProbeRecord) -> Result<Measured, Reference
     metrics.insert("u_center_rel_err_station".into(), ((u_c - u_c_ref) / u_c_ref).abs());
     metrics.insert("u_center_rel_err_developed".into(), ((u_c - developed) / developed).abs());
     let cross = averaged(probes, "velocity_profile_1", from);
-    let u_max = cross.iter().map(|&(_, u)| u).fold(f64::NAN, f64::max);
+    let u_max = super::nan_max(&cross.iter().map(|&(_, u)| u).collect::<Vec<_>>());
     metrics.insert("u_max_station".into(), u_max);
     metrics.insert("u_max_rel_err_developed".into(), ((u_max - developed) / developed).abs());
     let eta = |y: f64| ((y - ch.wall) / d).clamp(0.0, 1.0);

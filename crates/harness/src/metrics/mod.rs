@@ -94,12 +94,27 @@ pub fn nan_max(values: &[f64]) -> f64 {
     if values.is_empty() {
         return f64::NAN;
     }
-    values.iter().fold(f64::NEG_INFINITY, |m, &v| if v.is_nan() || m.is_nan() { f64::NAN } else { m.max(v) })
+    values.iter().copied().fold(f64::NEG_INFINITY, sticky_max)
+}
+
+/// The larger of `a` and `b`, NaN when either is (`f64::max` drops a NaN: a later finite
+/// sample must not overwrite an earlier NaN).
+pub fn sticky_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn nan_is_sticky_in_maxima() {
+        assert!(sticky_max(f64::NAN, 1.0).is_nan() && sticky_max(1.0, f64::NAN).is_nan());
+        assert_eq!(sticky_max(1.0, 2.0).to_bits(), 2.0f64.to_bits());
+        // A NaN early in a series survives the later finite samples.
+        assert!([0.1, f64::NAN, 0.2, 0.3].into_iter().fold(0.0, sticky_max).is_nan());
+        assert!(nan_max(&[0.1, f64::NAN, 0.3]).is_nan() && nan_max(&[]).is_nan());
+    }
 
     #[test]
     fn relative_error_norms() {

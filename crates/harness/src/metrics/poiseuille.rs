@@ -24,7 +24,7 @@
 //! and `F` = the x component of the body force from each run's scene, so presets may change
 //! the Reynolds number.
 
-use super::Measured;
+use super::{Measured, sticky_max};
 use meniscus::ProbeRecord;
 use meniscus_reference::ReferenceError;
 use meniscus_reference::poiseuille::PlanePoiseuille;
@@ -125,7 +125,7 @@ pub fn compute(
                 m.insert(format!("u_profile_l2_rel_{name}"), l2);
                 m.insert(format!("u_profile_linf_rel_{name}"), linf);
                 if target < 1.0 {
-                    startup_max = Some(startup_max.map_or(l2, |s| if l2.is_nan() { l2 } else { s.max(l2) }));
+                    startup_max = Some(startup_max.map_or(l2, |s| sticky_max(s, l2)));
                 } else {
                     m.insert("u_profile_l2_rel_steady".into(), l2);
                     m.insert("u_profile_linf_rel_steady".into(), linf);
@@ -144,7 +144,7 @@ pub fn compute(
                 f64::NAN
             };
             let dr = (diff / norm).sqrt();
-            drift = Some(drift.map_or(dr, |x| if dr.is_nan() { dr } else { x.max(dr) }));
+            drift = Some(drift.map_or(dr, |x| sticky_max(x, dr)));
         }
     }
     if let Some(s) = startup_max {
