@@ -11,8 +11,16 @@ struct Errors {
     particles: usize,
     b_max: f64,
     a_max: f64,
-    pc_final: f64,
+    /// The centre pressure over its reference, averaged over the last quarter of the run,
+    /// minus 1: the pressure oscillates (at dx = 0.04 its final sample is 1.4 % off and the
+    /// last quarter swings to 14 %), so one sample is a draw.
+    pc_late: f64,
     ke_drift: f64,
+}
+
+/// The larger of `a` and `b`, NaN when either is (a NaN sample must not vanish from a max).
+fn sticky_max(a: f64, b: f64) -> f64 {
+    if a.is_nan() || b.is_nan() { f64::NAN } else { a.max(b) }
 }
 
 fn measure(edit: impl FnOnce(&mut serde_json::Value)) -> Errors {
@@ -27,17 +35,24 @@ fn measure(edit: impl FnOnce(&mut serde_json::Value)) -> Errors {
         EllipticalDrop::new(1.0, 100.0, 1000.0).expect("valid").states_at(&probes.t).expect("integrates");
     let rel_max = |name: &str, pick: fn(&meniscus_reference::elliptical_drop::DropState) -> f64| {
         let series = probes.get("ellipse_axes", name).expect("ellipse probe");
-        series.iter().zip(&exact).map(|(v, e)| ((v - pick(e)) / pick(e)).abs()).fold(0.0, f64::max)
+        series.iter().zip(&exact).map(|(v, e)| ((v - pick(e)) / pick(e)).abs()).fold(0.0, sticky_max)
     };
     let p = probes.get("pressure_at", "p").expect("pressure probe");
     let e = probes.get("kinetic_energy", "e").expect("energy probe");
-    let last = exact.last().expect("samples");
+    let t = &probes.t;
+    let late_from = t[t.len() - 1] * 0.75;
+    let late: Vec<f64> = t
+        .iter()
+        .zip(p.iter().zip(&exact))
+        .filter(|(ti, _)| **ti >= late_from)
+        .map(|(_, (p, e))| p / e.pc)
+        .collect();
     Errors {
         particles: report.summary.particles,
         b_max: rel_max("b_moment", |s| s.b),
         a_max: rel_max("a_moment", |s| s.a),
-        pc_final: ((p[p.len() - 1] - last.pc) / last.pc).abs(),
-        ke_drift: e.iter().map(|v| ((v - e[0]) / e[0]).abs()).fold(0.0, f64::max),
+        pc_late: (late.iter().sum::<f64>() / late.len() as f64 - 1.0).abs(),
+        ke_drift: e.iter().map(|v| ((v - e[0]) / e[0]).abs()).fold(0.0, sticky_max),
     }
 }
 
@@ -58,5 +73,5 @@ fn tuned_preset_is_accurate_in_pressure_too() {
     });
     assert!(e.b_max <= 0.02, "b error {:.4}", e.b_max);
     assert!(e.ke_drift <= 0.02, "kinetic energy drift {:.4}", e.ke_drift);
-    assert!(e.pc_final <= 0.05, "centre pressure error {:.4}", e.pc_final);
+    assert!(e.pc_late <= 0.05, "centre pressure error over the last quarter {:.4}", e.pc_late);
 }

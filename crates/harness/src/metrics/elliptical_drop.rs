@@ -11,13 +11,15 @@
 //! Metrics: `a_rel_err_max`, `b_rel_err_max`, `a_rel_err_final`, `b_rel_err_final`,
 //! `a_rel_err_initial`, `b_rel_err_initial`, `a_rel_err_max_ratio`, `b_rel_err_max_ratio`,
 //! `a_extent_rel_err_max`, `b_extent_rel_err_max`, `a_extent_rel_err_final`,
-//! `b_extent_rel_err_final`, `pc_rel_err_final`, `pc_rel_err_max`, `ke_drift`,
+//! `b_extent_rel_err_final`, `pc_rel_err_final`, `pc_rel_err_max`, `pc_rel_err_late` (the
+//! centre pressure over its reference averaged over the last quarter of the run: the
+//! pressure oscillates, acoustically under WCSPH, so its final sample is a draw), `ke_drift`,
 //! `ke_rel_err_initial` (against `rho pi R^4 A0^2 / 4`), `momentum_drift` (largest |linear
 //! momentum| over the scale `rho pi R^2 A0 R`), `t_final`.
 //! Series: `t`, `a_moment`, `b_moment`, `a_extent`, `b_extent`, `p`, `e`, and the
 //! reference `a_ref`, `b_ref`, `pc_ref` on the same `t`.
 
-use super::{Measured, drift, nan_max, rel_err_final, rel_err_max};
+use super::{Measured, drift, nan_max, rel_err_final, rel_err_late, rel_err_max};
 use meniscus::ProbeRecord;
 use meniscus_reference::ReferenceError;
 use meniscus_reference::elliptical_drop::EllipticalDrop;
@@ -32,6 +34,9 @@ pub struct Params {
     /// Density \[kg/m^3\].
     pub density: f64,
 }
+
+/// Fraction of the run, at its end, over which `pc_rel_err_late` averages.
+pub const LATE_FRACTION: f64 = 0.25;
 
 /// The probe kinds and quantities read (DESIGN.md "Run outputs").
 const AXES: &str = "ellipse_axes";
@@ -69,6 +74,7 @@ pub fn compute(params: &Params, probes: &ProbeRecord) -> Result<Measured, Refere
     }
     if let Some(p) = probes.get("pressure_at", "p") {
         m.insert("pc_rel_err_final".into(), rel_err_final(p, &pc_ref));
+        m.insert("pc_rel_err_late".into(), rel_err_late(t, p, &pc_ref, LATE_FRACTION));
         m.insert("pc_rel_err_max".into(), rel_err_max(p, &pc_ref));
         out.series.insert("p".into(), p.to_vec());
     }

@@ -81,6 +81,25 @@ pub fn rel_err_final(values: &[f64], reference: &[f64]) -> f64 {
     }
 }
 
+/// Relative error of an oscillating quantity judged over the late history: the mean of
+/// `values / reference` over the samples in the last `fraction` of the time span, minus 1,
+/// in absolute value (one sample of an oscillation is a draw, its window mean is not). NaN
+/// when a sample in the window is, or there is none.
+pub fn rel_err_late(t: &[f64], values: &[f64], reference: &[f64], fraction: f64) -> f64 {
+    let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else { return f64::NAN };
+    let from = t1 - fraction * (t1 - t0);
+    let ratios: Vec<f64> = t
+        .iter()
+        .zip(values.iter().zip(reference))
+        .filter(|(ti, _)| **ti >= from)
+        .map(|(_, (v, r))| v / r)
+        .collect();
+    if ratios.is_empty() {
+        return f64::NAN;
+    }
+    (ratios.iter().sum::<f64>() / ratios.len() as f64 - 1.0).abs()
+}
+
 /// Largest relative drift from the first sample, `max_t |x(t) - x(0)| / |x(0)|`.
 pub fn drift(values: &[f64]) -> f64 {
     match values.first() {
@@ -106,6 +125,23 @@ pub fn sticky_max(a: f64, b: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn late_error_is_that_of_the_window_mean() {
+        let t: Vec<f64> = (0..=8).map(f64::from).collect();
+        let reference = vec![2.0; 9];
+        // ±10 % oscillation about +2 % in the last quarter (t = 6, 7, 8): mean +2 % … of
+        // three samples (1.12, 0.92, 1.12) → 1.0533, a 5.3 % error; the last sample alone is 12 %.
+        let v: Vec<f64> =
+            t.iter().map(|&x| 2.0 * (1.02 + if (x as i32) % 2 == 0 { 0.1 } else { -0.1 })).collect();
+        let late = rel_err_late(&t, &v, &reference, 0.25);
+        assert!((late - (1.12 + 0.92 + 1.12) / 3.0 + 1.0).abs() < 1e-12, "{late}");
+        assert!((rel_err_final(&v, &reference) - 0.12).abs() < 1e-12);
+        let mut gap = v.clone();
+        gap[7] = f64::NAN;
+        assert!(rel_err_late(&t, &gap, &reference, 0.25).is_nan());
+        assert!(rel_err_late(&[], &[], &[], 0.25).is_nan());
+    }
 
     #[test]
     fn nan_is_sticky_in_maxima() {
