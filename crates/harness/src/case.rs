@@ -94,6 +94,31 @@ pub struct Preset {
     /// Tiers in which this preset runs (all when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tiers: Option<Vec<Tier>>,
+    /// Spacings at which this preset is known to diverge, with the measured reason: such a
+    /// run's divergence is an expected failure, its completion an unexpected pass. Any
+    /// other run must reach its end time.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub expected_divergence: Option<ExpectedDivergence>,
+}
+
+/// Where and why a preset diverges (`sweep.presets[].expected_divergence`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectedDivergence {
+    /// Spacings \[m\] (of `sweep.dx`).
+    pub dx: Vec<f64>,
+    /// The measured cause (where it diverges, why, and where it is documented).
+    pub reason: String,
+}
+
+impl Preset {
+    /// The reason the preset is expected to diverge at `dx`, if it is.
+    pub fn expected_divergence_at(&self, dx: f64) -> Option<&str> {
+        self.expected_divergence
+            .as_ref()
+            .filter(|e| e.dx.iter().any(|&d| (d - dx).abs() <= 1e-9 * d.abs()))
+            .map(|e| e.reason.as_str())
+    }
 }
 
 fn empty_object() -> serde_json::Value {
@@ -301,6 +326,26 @@ impl Case {
             }
             if !names.insert(&p.name) {
                 return Err(err(format!("preset `{}` is defined twice", p.name)));
+            }
+        }
+        for p in &self.sweep.presets {
+            if let Some(e) = &p.expected_divergence {
+                if e.reason.trim().is_empty() {
+                    return Err(err(format!(
+                        "preset `{}`: `expected_divergence.reason` is empty: give the measured cause",
+                        p.name
+                    )));
+                }
+                if let Some(d) = e
+                    .dx
+                    .iter()
+                    .find(|&&d| !self.sweep.dx.values().flatten().any(|&s| (s - d).abs() <= 1e-9 * d.abs()))
+                {
+                    return Err(err(format!(
+                        "preset `{}`: `expected_divergence.dx` has {d}, not a spacing of `sweep.dx`",
+                        p.name
+                    )));
+                }
             }
         }
         for (tier, dx) in &self.sweep.dx {

@@ -250,6 +250,7 @@ pub fn assemble(case: &Case, tier: Tier, runs: Vec<RunResult>) -> CaseResults {
             expected_failure: None,
         });
     }
+    checks.extend(completion_checks(case, &runs));
     CaseResults {
         case: case.case.clone(),
         scheme: case.scheme.clone(),
@@ -258,6 +259,42 @@ pub fn assemble(case: &Case, tier: Tier, runs: Vec<RunResult>) -> CaseResults {
         convergence,
         checks,
     }
+}
+
+/// Every run reaches its end time: one check for the runs no preset expects to diverge
+/// (failing with the slugs of those that did not), and one strict expected failure per run
+/// that its preset expects to diverge (`expected_divergence`, with its reason): its
+/// completion is an unexpected pass.
+fn completion_checks(case: &Case, runs: &[RunResult]) -> Vec<crate::results::CheckResult> {
+    let expected = |r: &RunResult| {
+        case.sweep.presets.iter().find(|p| p.name == r.preset).and_then(|p| p.expected_divergence_at(r.dx))
+    };
+    let mut out = Vec::new();
+    let unmarked: Vec<&RunResult> = runs.iter().filter(|r| expected(r).is_none()).collect();
+    if !unmarked.is_empty() {
+        let stopped: Vec<String> = unmarked.iter().filter(|r| !r.ok()).map(|r| r.slug()).collect();
+        out.push(crate::results::CheckResult {
+            name: "every run reaches its end time".into(),
+            value: Some(stopped.len() as f64),
+            threshold: Some(0.0),
+            pass: stopped.is_empty(),
+            note: (!stopped.is_empty()).then(|| format!("did not: {}", stopped.join(", "))),
+            expected_failure: None,
+        });
+    }
+    for r in runs {
+        if let Some(reason) = expected(r) {
+            out.push(crate::results::CheckResult {
+                name: format!("{} reaches its end time", r.slug()),
+                value: None,
+                threshold: None,
+                pass: r.ok(),
+                note: (!r.ok()).then(|| r.status.clone()),
+                expected_failure: Some(reason.to_string()),
+            });
+        }
+    }
+    out
 }
 
 /// Observed orders of the case's convergence metrics, from the runs that completed. The
@@ -362,7 +399,7 @@ mod tests {
         assert!(!case.checks.is_empty());
         let runs = results(vec![synthetic("paper", 0.04, 5.0, 1976)]).runs;
         let res = assemble(&case, Tier::Quick, runs);
-        assert_eq!(res.checks.len(), 1, "{:?}", res.checks);
+        assert_eq!(res.checks.len(), 2, "that one and the completion check: {:?}", res.checks);
         assert!(!res.checks[0].pass && res.checks[0].name.contains("at least one check"));
         assert!(!res.pass());
     }
@@ -438,6 +475,45 @@ mod tests {
         let panicked = run_result(&drop_case(), &spec, &Ran::Panicked { message: "boom".into() }).unwrap();
         assert_eq!(panicked.status, "diverged: the solver panicked: boom");
         assert!(panicked.metrics.is_empty() && panicked.particles == 0 && !panicked.ok());
+    }
+
+    /// Every run reaches its end time unless its preset expects it to diverge there: then
+    /// its divergence is an expected failure and its completion an unexpected pass.
+    #[test]
+    fn runs_must_complete_unless_expected_to_diverge() {
+        use crate::case::ExpectedDivergence;
+        use crate::results::Verdict;
+        let diverged = |dx, particles| {
+            let mut r = synthetic("paper", dx, 5.0, particles);
+            r.summary.status = meniscus::Status::Diverged;
+            r.summary.error = Some("diverged in stage `guard` at step 9".into());
+            r
+        };
+        let completion = |case: &Case, recs: Vec<RunRecord>| {
+            let runs = results(recs).runs;
+            let out = assemble(case, Tier::Quick, runs).checks;
+            out.into_iter().filter(|c| c.name.contains("reaches its end time")).collect::<Vec<_>>()
+        };
+        let mut case = drop_case();
+        let c = completion(&case, vec![synthetic("paper", 0.04, 5.0, 1976), diverged(0.02, 7860)]);
+        assert_eq!(c.len(), 1);
+        assert!(!c[0].pass && c[0].note.as_deref().unwrap_or("").contains("isph-paper_dx0.02"), "{c:?}");
+        case.sweep.presets[0].expected_divergence =
+            Some(ExpectedDivergence { dx: vec![0.02], reason: "measured: flung off".into() });
+        let c = completion(&case, vec![synthetic("paper", 0.04, 5.0, 1976), diverged(0.02, 7860)]);
+        let verdicts: Vec<Verdict> = c.iter().map(|c| c.verdict()).collect();
+        assert_eq!(verdicts, [Verdict::Pass, Verdict::ExpectedFail], "{c:?}");
+        let c =
+            completion(&case, vec![synthetic("paper", 0.04, 5.0, 1976), synthetic("paper", 0.02, 5.0, 7860)]);
+        assert_eq!(c[1].verdict(), Verdict::UnexpectedPass);
+        // The marking names a spacing of the sweep and a reason.
+        let mut v = serde_json::to_value(&case).unwrap();
+        v["sweep"]["presets"][0]["expected_divergence"]["dx"] = serde_json::json!([0.03]);
+        let e = Case::from_json(&v.to_string(), Path::new("x.json")).unwrap_err().to_string();
+        assert!(e.contains("expected_divergence.dx") && e.contains("0.03"), "{e}");
+        v["sweep"]["presets"][0]["expected_divergence"] = serde_json::json!({"dx": [0.02], "reason": " "});
+        let e = Case::from_json(&v.to_string(), Path::new("x.json")).unwrap_err().to_string();
+        assert!(e.contains("expected_divergence.reason"), "{e}");
     }
 
     /// A tiny real solver run (dx = 0.1, two steps) through the whole pipeline, twice:
