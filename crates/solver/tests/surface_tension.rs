@@ -37,18 +37,25 @@ fn no_surface_tension_builds_no_stage() {
 }
 
 #[test]
-fn both_forms_compress_the_drop_to_a_laplace_pressure() {
+fn both_forms_compress_the_drop_to_their_measured_laplace_pressure() {
     // Starting from p = 0, the surface tension squeezes the drop until the inside pressure
-    // balances it: positive, of the order of σ/R = 5 Pa (measured 2.2 Pa Hu–Adams, 3.7 Pa
-    // CSF over the last quarter of 0.15 s, threshold 0.1/h, not normalised: the single-fluid colour gradient carries about half of the surface
-    // delta), one body, spurious speeds well below the capillary speed √(σ/(ρR)) = 2.2 m/s.
-    for model in ["hu_adams", "csf"] {
+    // balances it: one body, spurious speeds well below the capillary speed
+    // √(σ/(ρR)) = 2.2 m/s, and an inside pressure short of σ/R = 5 Pa by what each model
+    // is known to miss here (threshold 0.1/h, not normalised: the single-fluid colour
+    // gradient carries about half of the surface delta; docs/notes/surface-tension.md).
+    // The bands pin those shortfalls (2.23 Pa Hu–Adams, 3.71 Pa CSF over the last quarter
+    // of 0.15 s, measured 2026-12-05) to ±10 %, so that a change either way shows; the
+    // models' accuracy is judged, failing, by the static_drop case's expected failures.
+    for (model, measured) in [("hu_adams", 2.23), ("csf", 3.71)] {
         let report = meniscus::run(&drop(model, wcsph(), 1.0), &mut meniscus::Quiet).expect("builds");
         assert!(report.error.is_none(), "{model}: {:?}", report.error);
         let p = report.probes.get("pressure_at", "p").expect("probe");
         let n = p.len();
         let late: f64 = p[3 * n / 4..].iter().sum::<f64>() / (n - 3 * n / 4) as f64;
-        assert!(late > 0.25 * 5.0 && late < 2.0 * 5.0, "{model}: inside pressure {late} Pa");
+        assert!(
+            (late - measured).abs() <= 0.1 * measured,
+            "{model}: inside pressure {late} Pa, {measured} Pa measured"
+        );
         let u = report.probes.get("max_speed", "u_max").expect("probe");
         assert!(u[n - 1] < 0.2, "{model}: spurious speed {} m/s", u[n - 1]);
         let clusters = report.probes.get("drop_shape", "clusters").expect("probe");
