@@ -19,7 +19,7 @@
 
 use crate::error::{HarnessError, Result};
 use crate::io;
-use crate::results::{CaseResults, RunResult, case_dirs, slug};
+use crate::results::{CaseResults, RunResult, case_dirs};
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
@@ -389,9 +389,12 @@ impl Comparison {
     }
 }
 
-/// Whether two runs are the same point of the sweep: same scheme, preset and dx.
+/// Whether two runs are the same point of the sweep: same scheme, preset, dx and start.
 pub fn same_run(a: &RunResult, b: &RunResult) -> bool {
-    a.scheme == b.scheme && a.preset == b.preset && (a.dx - b.dx).abs() <= 1e-9 * a.dx.abs().max(b.dx.abs())
+    a.scheme == b.scheme
+        && a.preset == b.preset
+        && a.start == b.start
+        && (a.dx - b.dx).abs() <= 1e-9 * a.dx.abs().max(b.dx.abs())
 }
 
 fn compare_run(old: &RunResult, new: &RunResult, band: &NoiseBand) -> RunComparison {
@@ -437,12 +440,8 @@ pub fn compare_case(new: &CaseResults, old: Option<&CaseResults>, band: &NoiseBa
             None => added_runs.push(r.slug()),
         }
     }
-    let removed_runs = base
-        .runs
-        .iter()
-        .filter(|b| !new.runs.iter().any(|r| same_run(b, r)))
-        .map(|b| slug(&b.scheme, &b.preset, b.dx))
-        .collect();
+    let removed_runs =
+        base.runs.iter().filter(|b| !new.runs.iter().any(|r| same_run(b, r))).map(RunResult::slug).collect();
     let order_names: BTreeSet<&String> = base.convergence.keys().chain(new.convergence.keys()).collect();
     let orders = order_names
         .into_iter()

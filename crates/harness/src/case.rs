@@ -99,6 +99,39 @@ pub struct Preset {
     /// other run must reach its end time.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub expected_divergence: Option<ExpectedDivergence>,
+    /// Extra runs of the preset from perturbed starts, at some spacings: a quantity that a
+    /// bit-level change of the trajectory redraws is judged over them (worst member for a
+    /// bound, member mean for a convergence fit; [`crate::checks`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub perturbed_starts: Option<PerturbedStarts>,
+}
+
+/// The perturbed starts of a preset (`sweep.presets[].perturbed_starts`): at each spacing
+/// of `dx`, one more run per seed with every fluid body's lattice jittered by
+/// `fraction · dx` (`bodies[].jitter`, uniform in the ball, ChaCha8 from the seed). The
+/// unperturbed run is the ensemble's first member.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PerturbedStarts {
+    /// Spacings \[m\] (of `sweep.dx`).
+    pub dx: Vec<f64>,
+    /// Jitter seeds, one run each (distinct).
+    pub seeds: Vec<u64>,
+    /// Jitter radius over Δx: small enough not to change the discretisation (default
+    /// 1e-12, at most 1e-6).
+    #[serde(default = "default_start_fraction")]
+    pub fraction: f64,
+    /// Why the quantity needs an ensemble (what a bit-level change redraws, measured).
+    pub reason: String,
+}
+
+fn default_start_fraction() -> f64 {
+    1e-12
+}
+
+/// Whether `dx` is one of `spacings` (to 1e-9 relative).
+fn listed(spacings: &[f64], dx: f64) -> bool {
+    spacings.iter().any(|&d| (d - dx).abs() <= 1e-9 * d.abs())
 }
 
 /// Where and why a preset diverges (`sweep.presets[].expected_divergence`).
@@ -114,10 +147,12 @@ pub struct ExpectedDivergence {
 impl Preset {
     /// The reason the preset is expected to diverge at `dx`, if it is.
     pub fn expected_divergence_at(&self, dx: f64) -> Option<&str> {
-        self.expected_divergence
-            .as_ref()
-            .filter(|e| e.dx.iter().any(|&d| (d - dx).abs() <= 1e-9 * d.abs()))
-            .map(|e| e.reason.as_str())
+        self.expected_divergence.as_ref().filter(|e| listed(&e.dx, dx)).map(|e| e.reason.as_str())
+    }
+
+    /// The seeds of the perturbed starts run at `dx` (empty when none are).
+    pub fn starts_at(&self, dx: f64) -> &[u64] {
+        self.perturbed_starts.as_ref().filter(|s| listed(&s.dx, dx)).map_or(&[], |s| s.seeds.as_slice())
     }
 }
 
@@ -348,6 +383,12 @@ impl Case {
                 }
             }
         }
+        for p in &self.sweep.presets {
+            if let Some(s) = &p.perturbed_starts {
+                self.check_starts(s)
+                    .map_err(|m| err(format!("preset `{}`: `perturbed_starts.{m}", p.name)))?;
+            }
+        }
         for (tier, dx) in &self.sweep.dx {
             if let Some(bad) = dx.iter().find(|d| !(d.is_finite() && **d > 0.0)) {
                 return Err(err(format!("sweep.dx.{tier} has {bad}: spacings must be positive")));
@@ -370,6 +411,33 @@ impl Case {
 }
 
 impl Case {
+    /// A preset's perturbed starts are well formed; the message begins with the field.
+    fn check_starts(&self, s: &PerturbedStarts) -> std::result::Result<(), String> {
+        let all: Vec<f64> = self.sweep.dx.values().flatten().copied().collect();
+        if s.reason.trim().is_empty() {
+            return Err("reason` is empty: say what a bit-level change of the start redraws".into());
+        }
+        if s.dx.is_empty() {
+            return Err("dx` is empty: give the spacings of the ensemble".into());
+        }
+        if let Some(d) = s.dx.iter().find(|&&d| !listed(&all, d)) {
+            return Err(format!("dx` has {d}, not a spacing of `sweep.dx`"));
+        }
+        let mut seeds = s.seeds.clone();
+        seeds.sort_unstable();
+        seeds.dedup();
+        if s.seeds.is_empty() || seeds.len() != s.seeds.len() {
+            return Err(format!("seeds` = {:?}: give one or more distinct seeds", s.seeds));
+        }
+        if !(s.fraction > 0.0 && s.fraction <= 1e-6) {
+            return Err(format!(
+                "fraction` = {}: must be in (0, 1e-6] (a perturbation, not a disordered lattice)",
+                s.fraction
+            ));
+        }
+        Ok(())
+    }
+
     /// A check's selector names what the sweep runs: a preset of the case, one of its
     /// spacings, a scheme of its presets; and each tier the check lists runs what it
     /// selects. (A misspelt selector would match nothing and the check would vanish.)

@@ -17,6 +17,10 @@
 //! metric that is missing or not finite, fails the check (with a `note` saying why; the
 //! check's `missing` replaces the note of a missing metric).
 //!
+//! A preset's perturbed starts (`sweep.presets[].perturbed_starts`) are more runs at the
+//! same spacing: a bound judges every member (the worst is the value, the note gives the
+//! spread), `decreasing` and `order` fit the members' mean at each spacing.
+//!
 //! The stability envelope's rows are checked by the same specs ([`Checked`]): their
 //! selectors also name the `study` and `case` of a row, and a row's status does not fail
 //! a check.
@@ -313,38 +317,75 @@ fn bound(
             None => missing.push(r.slug()),
         }
     }
-    let note = (!missing.is_empty()).then(|| {
+    let absent = (!missing.is_empty()).then(|| {
         missing_note.map_or_else(
             || format!("`{metric}` missing or not finite in {}", missing.join(", ")),
             str::to_string,
         )
     });
+    let pass = pass && absent.is_none();
+    let note = [absent, spread(runs, metric)].into_iter().flatten().reduce(|a, b| format!("{a}; {b}"));
     CheckResult {
         name: name.to_string(),
         value,
         threshold: Some(threshold),
-        pass: pass && note.is_none(),
+        pass,
         note,
         expected_failure: None,
     }
 }
 
-/// Groups runs by (scheme, preset), each sorted from coarse to fine, with their metric.
-/// (scheme, preset) → `(dx, metric)` from coarse to fine.
+/// (scheme, preset) → `(dx, metric)` from coarse to fine ([`per_spacing`]).
 type Groups = BTreeMap<(String, String), Vec<(f64, Option<f64>)>>;
 
 fn by_group(runs: &[&RunResult], metric: &str) -> Groups {
-    let mut groups = Groups::new();
+    let mut members: BTreeMap<(String, String), Vec<&RunResult>> = BTreeMap::new();
     for r in runs {
-        groups
-            .entry((r.scheme.clone(), r.preset.clone()))
-            .or_default()
-            .push((r.dx, r.metric(metric).filter(|v| v.is_finite())));
+        members.entry((r.scheme.clone(), r.preset.clone())).or_default().push(r);
     }
-    for g in groups.values_mut() {
-        g.sort_by(|a, b| b.0.total_cmp(&a.0));
+    members.into_iter().map(|(k, rs)| (k, per_spacing(&rs, metric))).collect()
+}
+
+/// The metric of `runs` (one preset) at each of their spacings, coarse to fine: the value
+/// of the run there, or the mean over its perturbed starts (`perturbed_starts`), so a fit
+/// through the points judges the ensemble, not one draw; `None` where a member lacks a
+/// finite value.
+pub fn per_spacing(runs: &[&RunResult], metric: &str) -> Vec<(f64, Option<f64>)> {
+    let mut out: Vec<(f64, Vec<Option<f64>>)> = Vec::new();
+    for r in runs {
+        let v = r.metric(metric).filter(|v| v.is_finite());
+        match out.iter_mut().find(|(d, _)| (d - r.dx).abs() <= 1e-9 * d.abs()) {
+            Some((_, vs)) => vs.push(v),
+            None => out.push((r.dx, vec![v])),
+        }
     }
-    groups
+    out.sort_by(|a, b| b.0.total_cmp(&a.0));
+    out.into_iter()
+        .map(|(d, vs)| {
+            let n = vs.len() as f64;
+            (d, vs.into_iter().sum::<Option<f64>>().map(|sum| sum / n))
+        })
+        .collect()
+}
+
+/// The spread of a bound check's runs that are perturbed starts of one another: "over N
+/// starts: min – max" for each spacing and preset with more than one member.
+fn spread(runs: &[&RunResult], metric: &str) -> Option<String> {
+    let mut members: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    for r in runs {
+        let key = crate::results::slug(&r.scheme, &r.preset, r.dx);
+        members.entry(key).or_default().extend(r.metric(metric).filter(|v| v.is_finite()));
+    }
+    let parts: Vec<String> = members
+        .into_iter()
+        .filter(|(_, vs)| vs.len() > 1)
+        .map(|(slug, vs)| {
+            let lo = vs.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = vs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            format!("{slug} over {} starts: {lo:.4e} – {hi:.4e}", vs.len())
+        })
+        .collect();
+    (!parts.is_empty()).then(|| parts.join("; "))
 }
 
 fn decreasing(name: &str, runs: &[&RunResult], metric: &str) -> Option<CheckResult> {
@@ -435,6 +476,7 @@ mod tests {
             scheme: "isph".into(),
             preset: preset.into(),
             dx,
+            start: None,
             particles,
             steps: 400,
             wall_s: 1.0,
@@ -580,6 +622,38 @@ mod tests {
         assert!((r.value.unwrap() - 2.0).abs() < 1e-12);
         let c = spec(json!({"kind": "order", "metric": "b_rel_err_max", "min": 1.5}));
         assert!(!c.evaluate(&runs(), Tier::Quick).unwrap().pass);
+    }
+
+    #[test]
+    fn perturbed_starts_are_judged_as_an_ensemble() {
+        // Two more starts of `paper` at 0.02 (errors 0.004 and 0.009 beside the 0.005 of the
+        // unperturbed run): a bound judges the worst member and gives the spread, the order
+        // fits the members' mean (0.006: order log2(0.02 / 0.006) = 1.74).
+        let mut rs = runs();
+        for (seed, err) in [(1, 0.004), (2, 0.009)] {
+            let mut r = run("paper", 0.02, err, 7860, "ok");
+            r.start = Some(seed);
+            rs.push(r);
+        }
+        assert_eq!(rs[4].slug(), "isph-paper_dx0.02_start1");
+        let c =
+            spec(json!({"metric": "b_rel_err_max", "select": {"dx": 0.02, "preset": "paper"}, "max": 0.008}));
+        let r = c.evaluate(&rs, Tier::Quick).unwrap();
+        assert!(!r.pass, "one start of three is over the bound");
+        assert_eq!(r.value, Some(0.009));
+        assert!(
+            r.note.as_deref().unwrap().contains("isph-paper_dx0.02 over 3 starts: 4.0000e-3 – 9.0000e-3"),
+            "{r:?}"
+        );
+        let c = spec(
+            json!({"kind": "order", "metric": "b_rel_err_max", "select": {"preset": "paper"}, "min": 1.5}),
+        );
+        let r = c.evaluate(&rs, Tier::Quick).unwrap();
+        assert!((r.value.unwrap() - (0.02f64 / 0.006).log2()).abs() < 1e-12, "{r:?}");
+        // A member without the metric leaves its spacing without a mean: no verdict.
+        rs[5].metrics.clear();
+        let r = c.evaluate(&rs, Tier::Quick).unwrap();
+        assert!(!r.pass && r.value.is_none() && r.note.as_deref().unwrap().contains("isph-paper"), "{r:?}");
     }
 
     #[test]

@@ -14,6 +14,10 @@ pub struct RunResult {
     pub preset: String,
     /// Particle spacing \[m\].
     pub dx: f64,
+    /// The jitter seed of a perturbed start (`sweep.presets[].perturbed_starts`); absent
+    /// for the unperturbed run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub start: Option<u64>,
     /// Number of particles.
     pub particles: usize,
     /// Steps taken.
@@ -46,9 +50,10 @@ impl RunResult {
         self.status == "ok"
     }
 
-    /// The stable run slug, e.g. `isph-paper_dx0.02`.
+    /// The stable run slug, e.g. `isph-paper_dx0.02` (`isph-long_dx0.02_start3` for a
+    /// perturbed start).
     pub fn slug(&self) -> String {
-        slug(&self.scheme, &self.preset, self.dx)
+        start_slug(&slug(&self.scheme, &self.preset, self.dx), self.start)
     }
 
     /// A metric, falling back to the run's own numeric fields (`particles`, `steps`,
@@ -90,6 +95,14 @@ pub const FLOOR_CORE_US_PER_PARTICLE_PASS: f64 = 420.0 * 2.0 / 7860.0;
 /// The stable slug of a run: `<scheme>-<preset>_dx<dx>` (dx in shortest decimal form).
 pub fn slug(scheme: &str, preset: &str, dx: f64) -> String {
     format!("{scheme}-{preset}_dx{dx}")
+}
+
+/// The slug of a perturbed start of the run `slug`: `<slug>_start<seed>`.
+pub fn start_slug(slug: &str, start: Option<u64>) -> String {
+    match start {
+        Some(seed) => format!("{slug}_start{seed}"),
+        None => slug.to_string(),
+    }
 }
 
 /// Observed order of one metric.
@@ -349,6 +362,7 @@ mod tests {
             scheme: "isph".into(),
             preset: "paper".into(),
             dx: 0.04,
+            start: None,
             particles: 10,
             steps: 3,
             wall_s: 0.1,

@@ -4,7 +4,7 @@ use crate::cache::sha256_hex;
 use crate::case::Case;
 use crate::error::{HarnessError, Result};
 use crate::patch::merge_patch;
-use crate::results::slug;
+use crate::results::{slug, start_slug};
 use crate::tier::Tier;
 
 /// One parameter point of a sweep (or of a study), with its effective scene.
@@ -18,6 +18,8 @@ pub struct RunSpec {
     pub preset: String,
     /// Spacing \[m\].
     pub dx: f64,
+    /// The jitter seed of a perturbed start (none for the unperturbed run).
+    pub start: Option<u64>,
     /// Stable slug, e.g. `isph-paper_dx0.02`.
     pub slug: String,
     /// The parsed and validated effective scene.
@@ -42,6 +44,7 @@ impl RunSpec {
             scheme: scene.scheme.key().to_string(),
             preset: preset.to_string(),
             dx,
+            start: None,
             slug,
             scene,
             scene_json: canonical,
@@ -104,7 +107,41 @@ pub fn build_fingerprint() -> &'static str {
     env!("MENISCUS_SOLVER_FINGERPRINT")
 }
 
-/// Every run of `case` in `tier`: spacings from coarse to fine, presets in file order.
+/// The run of `preset` at `dx` from the start perturbed with jitter seed `seed`
+/// (`perturbed_starts`): every fluid body's lattice jittered by `fraction · dx`.
+pub fn perturbed_spec(case: &Case, preset: &str, dx: f64, seed: u64) -> Result<RunSpec> {
+    let mut value = effective_scene(case, preset, dx)?;
+    let fraction = case
+        .sweep
+        .presets
+        .iter()
+        .find(|p| p.name == preset)
+        .and_then(|p| p.perturbed_starts.as_ref())
+        .map_or(1e-12, |s| s.fraction);
+    let base = spec(case, preset, dx)?;
+    let slug = start_slug(&base.slug, Some(seed));
+    let Some(bodies) = value["bodies"].as_array_mut() else {
+        return Err(HarnessError::case(
+            &case.case,
+            format!("run {slug}: the scene has no `bodies` to perturb"),
+        ));
+    };
+    for body in bodies.iter_mut().filter(|b| b["role"] == "fluid") {
+        if body.get("jitter").is_some() {
+            return Err(HarnessError::case(
+                &case.case,
+                format!("run {slug}: a fluid body already has `jitter`; a perturbed start would replace it"),
+            ));
+        }
+        body["jitter"] = serde_json::json!({"fraction": fraction, "seed": seed});
+    }
+    let mut run = RunSpec::from_json(&case.case, slug, preset, dx, &value)?;
+    run.start = Some(seed);
+    Ok(run)
+}
+
+/// Every run of `case` in `tier`: spacings from coarse to fine, presets in file order, each
+/// preset's perturbed starts after its run.
 pub fn expand(case: &Case, tier: Tier) -> Result<Vec<RunSpec>> {
     let mut dx = case.spacings(tier).to_vec();
     if dx.is_empty() {
@@ -112,11 +149,14 @@ pub fn expand(case: &Case, tier: Tier) -> Result<Vec<RunSpec>> {
     }
     dx.sort_by(|a, b| b.total_cmp(a));
     dx.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
-    let presets: Vec<&str> = case.presets(tier).map(|p| p.name.as_str()).collect();
+    let presets: Vec<&crate::case::Preset> = case.presets(tier).collect();
     let mut out = Vec::with_capacity(dx.len() * presets.len());
     for &d in &dx {
         for p in &presets {
-            out.push(spec(case, p, d)?);
+            out.push(spec(case, &p.name, d)?);
+            for &seed in p.starts_at(d) {
+                out.push(perturbed_spec(case, &p.name, d, seed)?);
+            }
         }
     }
     Ok(out)
@@ -125,6 +165,7 @@ pub fn expand(case: &Case, tier: Tier) -> Result<Vec<RunSpec>> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::case::Case;
     use crate::case::testing::committed;
 
     #[test]
@@ -164,6 +205,42 @@ mod tests {
         assert!((dt(&full[0]) - 2e-5).abs() < 1e-18, "dx = 0.04 keeps the paper's dt");
         assert!((dt(&full[4]) - 2e-5).abs() < 1e-18);
         assert!((dt(&full[12]) - 5e-6).abs() < 1e-18, "dx = 0.005: {}", dt(&full[12]));
+    }
+
+    #[test]
+    fn perturbed_starts_add_jittered_runs() {
+        let mut c = committed("elliptical_drop");
+        let mut v = serde_json::to_value(&c).unwrap();
+        v["sweep"]["presets"][0]["perturbed_starts"] =
+            serde_json::json!({"dx": [0.02], "seeds": [1, 2], "reason": "the final pressure is a draw"});
+        c = Case::from_json(&v.to_string(), std::path::Path::new("x.json")).unwrap();
+        let runs = expand(&c, Tier::Quick).unwrap();
+        let slugs: Vec<&str> = runs.iter().map(|r| r.slug.as_str()).collect();
+        assert_eq!(
+            slugs[4..7],
+            ["isph-paper_dx0.02", "isph-paper_dx0.02_start1", "isph-paper_dx0.02_start2"]
+        );
+        assert_eq!(runs.len(), 10, "two more runs at 0.02, none at 0.04");
+        assert_eq!((runs[5].start, runs[6].start), (Some(1), Some(2)));
+        let jitter = &runs[6].scene_json["bodies"][0]["jitter"];
+        assert_eq!((jitter["fraction"].as_f64(), jitter["seed"].as_u64()), (Some(1e-12), Some(2)));
+        assert!(runs[4].scene_json["bodies"][0].get("jitter").is_none_or(|j| j.is_null()));
+        assert!(runs[4].hash != runs[5].hash && runs[5].hash != runs[6].hash);
+        // Malformed ensembles are rejected when the case loads, naming the field.
+        for (bad, field) in [
+            (serde_json::json!({"dx": [0.03], "seeds": [1], "reason": "r"}), "perturbed_starts.dx"),
+            (serde_json::json!({"dx": [0.02], "seeds": [], "reason": "r"}), "perturbed_starts.seeds"),
+            (serde_json::json!({"dx": [0.02], "seeds": [3, 3], "reason": "r"}), "perturbed_starts.seeds"),
+            (serde_json::json!({"dx": [0.02], "seeds": [1], "reason": " "}), "perturbed_starts.reason"),
+            (
+                serde_json::json!({"dx": [0.02], "seeds": [1], "fraction": 0.1, "reason": "r"}),
+                "perturbed_starts.fraction",
+            ),
+        ] {
+            v["sweep"]["presets"][0]["perturbed_starts"] = bad;
+            let e = Case::from_json(&v.to_string(), std::path::Path::new("x.json")).unwrap_err().to_string();
+            assert!(e.contains(field) && e.contains("`paper`"), "{field}: {e}");
+        }
     }
 
     #[test]

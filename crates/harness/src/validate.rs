@@ -214,6 +214,7 @@ pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
         scheme: spec.scheme.clone(),
         preset: spec.preset.clone(),
         dx: spec.dx,
+        start: spec.start,
         particles: 0,
         steps: 0,
         wall_s: 0.0,
@@ -297,7 +298,8 @@ fn completion_checks(case: &Case, runs: &[RunResult]) -> Vec<crate::results::Che
     out
 }
 
-/// Observed orders of the case's convergence metrics, from the runs that completed. The
+/// Observed orders of the case's convergence metrics, from the runs that completed (a
+/// perturbed-start ensemble by its mean, [`crate::checks::per_spacing`]). The
 /// headline order is the primary preset's; when that preset has no fit (runs diverged or
 /// the metric is undefined), the first preset (by name) that has one.
 pub fn convergence(case: &Case, runs: &[RunResult]) -> BTreeMap<String, Convergence> {
@@ -311,13 +313,9 @@ pub fn convergence(case: &Case, runs: &[RunResult]) -> BTreeMap<String, Converge
         presets.sort_unstable();
         presets.dedup();
         for preset in presets {
-            let mut pts: Vec<(f64, f64)> = runs
-                .iter()
-                .filter(|r| r.preset == preset && r.ok())
-                .filter_map(|r| r.metric(metric).map(|v| (r.dx, v)))
-                .collect();
-            pts.sort_by(|a, b| b.0.total_cmp(&a.0));
-            let (dx, e): (Vec<f64>, Vec<f64>) = pts.iter().copied().unzip();
+            let mine: Vec<&RunResult> = runs.iter().filter(|r| r.preset == preset && r.ok()).collect();
+            let pts = crate::checks::per_spacing(&mine, metric);
+            let (dx, e): (Vec<f64>, Vec<f64>) = pts.iter().filter_map(|&(d, v)| Some((d, v?))).unzip();
             if let Some(fit) = fit_power_law(&dx, &e) {
                 by_preset.insert(preset.to_string(), fit.order);
                 if preset == primary {

@@ -352,6 +352,15 @@ pub fn case_page(
             h3 { "Presets (JSON merge patches on the template)" }
             @for p in &c.sweep.presets {
                 p { b { (p.name) } @if !p.description.is_empty() { " — " (p.description) } }
+                @if let Some(e) = &p.expected_divergence {
+                    p class="note" { "Expected to diverge at dx = " (format!("{:?}", e.dx)) ": " (e.reason) }
+                }
+                @if let Some(s) = &p.perturbed_starts {
+                    p class="note" {
+                        "Perturbed starts at dx = " (format!("{:?}", s.dx)) ": seeds " (format!("{:?}", s.seeds))
+                        ", lattice displaced by " (format!("{:e}", s.fraction)) " dx. " (s.reason)
+                    }
+                }
                 pre { (serde_json::to_string_pretty(&p.patch).unwrap_or_default()) }
             }
         }

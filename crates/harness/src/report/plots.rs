@@ -274,8 +274,8 @@ pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[Str
     .map_err(plot_err(file))
 }
 
-/// Error against dx in log-log: one line per metric and preset, labelled with the fitted
-/// order, and a reference line of slope `slope` through the finest point of the first.
+/// Error against dx in log-log: one line per metric and preset (a perturbed-start ensemble
+/// by its mean), labelled with the fitted order, and a reference line of slope `slope` through the finest point of the first.
 pub fn convergence(
     file: &str,
     title: &str,
@@ -291,13 +291,12 @@ pub fn convergence(
     let mut lines = Vec::new();
     for (mi, m) in metrics.iter().enumerate() {
         for (pi, p) in presets.iter().enumerate() {
-            let mut pts: Vec<(f64, f64)> = runs
-                .iter()
-                .filter(|r| r.preset == *p && r.ok())
-                .filter_map(|r| r.metric(m).map(|v| (r.dx, v)))
-                .filter(|(d, v)| *d > 0.0 && *v > 0.0 && v.is_finite())
+            let mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p && r.ok()).collect();
+            let pts: Vec<(f64, f64)> = crate::checks::per_spacing(&mine, m)
+                .into_iter()
+                .filter_map(|(d, v)| Some((d, v?)))
+                .filter(|(d, v)| *d > 0.0 && *v > 0.0)
                 .collect();
-            pts.sort_by(|a, b| b.0.total_cmp(&a.0));
             if pts.is_empty() {
                 continue;
             }

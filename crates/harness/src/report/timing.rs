@@ -224,6 +224,7 @@ mod tests {
             scheme: "isph".into(),
             preset: preset.into(),
             dx: 0.02,
+            start: None,
             particles,
             steps,
             wall_s,
