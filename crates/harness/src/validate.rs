@@ -41,6 +41,24 @@ pub struct ValidateOptions {
     pub baseline: Option<PathBuf>,
 }
 
+impl ValidateOptions {
+    /// The quick tier of every case file in `<dir>/validation`, reports in `<dir>/reports`,
+    /// one run at a time, no progress bars, no baseline (a scratch workspace: tests).
+    pub fn quick_in(dir: &Path) -> Self {
+        ValidateOptions {
+            tier: Tier::Quick,
+            cases: vec![],
+            out: dir.join("reports"),
+            validation_dir: dir.join("validation"),
+            workspace: dir.to_path_buf(),
+            force: false,
+            jobs: 1,
+            progress: false,
+            baseline: None,
+        }
+    }
+}
+
 /// What a validation produced.
 #[derive(Debug, Clone)]
 pub struct Outcome {
@@ -532,17 +550,7 @@ mod tests {
             .retain(|c| c.select.preset.as_deref().is_none_or(|p| p == "paper") && c.select.dx.is_none());
         assert!(!case.checks.is_empty());
         io::write_json(&vdir.join("tiny_drop.json"), &case).unwrap();
-        let opts = ValidateOptions {
-            tier: Tier::Quick,
-            cases: vec![],
-            out: dir.path().join("reports"),
-            validation_dir: vdir.clone(),
-            workspace: dir.path().to_path_buf(),
-            force: false,
-            jobs: 1,
-            progress: false,
-            baseline: None,
-        };
+        let opts = ValidateOptions::quick_in(dir.path());
         let first = validate(&opts).unwrap();
         assert_eq!((first.executed, first.reused), (1, 0));
         let res = &first.results[0];

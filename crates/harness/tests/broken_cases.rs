@@ -2,7 +2,7 @@
 //! naming the check (issue #34): a misspelt preset in a check, a metric removed from a
 //! run, a NaN injected late in a series.
 
-use meniscus_harness::{Case, Tier, ValidateOptions, validate};
+use meniscus_harness::{Case, ValidateOptions, validate};
 use std::path::{Path, PathBuf};
 
 /// The tiny drop (dx = 0.1, 20 steps, the paper preset only) with one check of ours,
@@ -25,17 +25,7 @@ fn tiny(name: &str, edit: impl FnOnce(&mut serde_json::Value)) -> (PathBuf, Vali
     ]);
     edit(&mut v);
     std::fs::write(dir.join("validation/tiny.json"), v.to_string()).expect("write case");
-    let opts = ValidateOptions {
-        tier: Tier::Quick,
-        cases: vec![],
-        out: dir.join("reports"),
-        validation_dir: dir.join("validation"),
-        workspace: dir.clone(),
-        force: false,
-        jobs: 1,
-        progress: false,
-        baseline: None,
-    };
+    let opts = ValidateOptions::quick_in(&dir);
     (dir, opts)
 }
 

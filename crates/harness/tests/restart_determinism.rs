@@ -48,17 +48,7 @@ fn restarted_sweep_reproduces_results_bit_for_bit() {
         serde_json::to_string_pretty(&case).expect("case JSON"),
     )
     .expect("write case");
-    let opts = ValidateOptions {
-        tier: Tier::Quick,
-        cases: vec![],
-        out: dir.join("reports"),
-        validation_dir: dir.join("validation"),
-        workspace: dir.clone(),
-        force: false,
-        jobs: 1,
-        progress: false,
-        baseline: None,
-    };
+    let opts = ValidateOptions::quick_in(&dir);
     let first = validate(&opts).expect("first sweep");
     assert_eq!((first.executed, first.reused), (2, 0));
     assert!(first.results[0].runs.iter().all(|r| r.ok()), "both runs finish");
