@@ -245,8 +245,9 @@ pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
     };
     if let Some(r) = ran.record() {
         let probes = meniscus::ProbeRecord::from(r.probes.clone());
-        let measured = metrics::compute(&case.reference, &r.scene, &probes, r.summary.particles)
-            .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
+        let measured =
+            metrics::compute(&case.reference, &r.scene, &probes, r.summary.particles, r.summary.steady_at)
+                .map_err(|source| HarnessError::Reference { case: case.case.clone(), source })?;
         (run.particles, run.steps, run.wall_s) = (r.summary.particles, r.summary.steps, r.summary.wall_s);
         (run.cpu_s, run.threads, run.steady_at) = (r.cpu_s, r.threads, r.summary.steady_at);
         (run.metrics, run.series) = (measured.metrics, measured.series);

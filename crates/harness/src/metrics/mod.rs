@@ -26,19 +26,21 @@ pub struct Measured {
 }
 
 /// Computes the metrics of a run's probes against `reference`; `scene` is the run's
-/// effective scene (references may take physical parameters from it).
+/// effective scene (references may take physical parameters from it), `steady_at` the
+/// time \[s\] at which its steady-state stop (`time.steady`) ended it, if it did.
 pub fn compute(
     reference: &ReferenceSpec,
     scene: &serde_json::Value,
     probes: &ProbeRecord,
     particles: usize,
+    steady_at: Option<f64>,
 ) -> Result<Measured, meniscus_reference::ReferenceError> {
     let mut m = match *reference {
         ReferenceSpec::EllipticalDrop { radius, a0, density } => {
             elliptical_drop::compute(&elliptical_drop::Params { radius, a0, density }, probes)?
         }
         ReferenceSpec::PoiseuilleStartup { width, wall } => {
-            poiseuille::compute(&poiseuille::channel(width, scene)?, wall, probes)?
+            poiseuille::compute(&poiseuille::channel(width, scene)?, wall, probes, steady_at)?
         }
         ReferenceSpec::EntranceFlow { width, wall } => {
             channel::compute(&channel::Channel::new(width, wall, scene)?, probes)?

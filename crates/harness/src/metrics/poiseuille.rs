@@ -12,7 +12,10 @@
 //! - `u_profile_l2_rel_startup_max`: the largest L2 error over the samples with `τ < 1`;
 //! - `u_profile_l2_rel_steady`, `u_profile_linf_rel_steady`, `u_center_rel_err_steady` (the
 //!   fastest bin against the reference at its position, over `u_max = F D² / 8ν`): at `τ = 1`
-//!   (where the transient is `e^{−π²} ≈ 5e-5` of `u_max`, below every error reported);
+//!   (where the transient is `e^{−π²} ≈ 5e-5` of `u_max`, below every error reported), or
+//!   at the sample where the steady-state stop (`time.steady`) ended the run before it,
+//!   against the series at that time (which holds what is left of the transient), with
+//!   `tau_steady` its `τ`;
 //! - `u_profile_drift`: for runs past `τ = 1`, the largest `‖u(t) − u(τ=1)‖₂ / ‖u_ref‖₂` after
 //!   it (a stable steady state does not drift);
 //! - `tau_final`: how far the run got.
@@ -87,11 +90,13 @@ fn errors(
     Ok(((num / den).sqrt(), emax / rmax))
 }
 
-/// Computes the metrics and series of one run; `wall` is the lower wall's position.
+/// Computes the metrics and series of one run; `wall` is the lower wall's position,
+/// `steady_at` \[s\] the time at which the steady-state stop ended the run, if it did.
 pub fn compute(
     channel: &PlanePoiseuille,
     wall: f64,
     probes: &ProbeRecord,
+    steady_at: Option<f64>,
 ) -> Result<Measured, ReferenceError> {
     let mut out = Measured::default();
     let t = &probes.t;
@@ -119,6 +124,7 @@ pub fn compute(
         let uc_ref = if yc.is_finite() { at(yc, ti)? } else { f64::NAN };
         centre_ref.push(uc_ref);
         l2s.push(l2);
+        let mut steady_here = false;
         for &target in &TAUS {
             if (tau - target).abs() <= TAU_MATCH * target {
                 let name = format!("t{:03}", (target * 100.0).round() as u32);
@@ -127,12 +133,23 @@ pub fn compute(
                 if target < 1.0 {
                     startup_max = Some(startup_max.map_or(l2, |s| sticky_max(s, l2)));
                 } else {
-                    m.insert("u_profile_l2_rel_steady".into(), l2);
-                    m.insert("u_profile_linf_rel_steady".into(), linf);
-                    m.insert("u_center_rel_err_steady".into(), (uc - uc_ref).abs() / channel.u_max().abs());
-                    steady = Some(prof.clone());
+                    steady_here = true;
                 }
             }
+        }
+        // The steady-state stop's sample, when it came before τ = 1.
+        if let Some(ts) = steady_at
+            && (ti - ts).abs() <= TAU_MATCH * ts
+            && tau < 1.0 - TAU_MATCH
+        {
+            m.insert("tau_steady".into(), tau);
+            steady_here = true;
+        }
+        if steady_here {
+            m.insert("u_profile_l2_rel_steady".into(), l2);
+            m.insert("u_profile_linf_rel_steady".into(), linf);
+            m.insert("u_center_rel_err_steady".into(), (uc - uc_ref).abs() / channel.u_max().abs());
+            steady = Some(prof.clone());
         }
         if let Some(s) = &steady
             && tau > 1.0 + TAU_MATCH
@@ -187,10 +204,10 @@ mod tests {
     fn exact_profiles_have_no_error_and_a_bias_is_measured() {
         let ch = PlanePoiseuille::new(0.2, 6e-8, 1e-6).unwrap();
         let taus = [0.0, 0.05, 0.1, 0.2, 0.5, 1.0];
-        let m = compute(&ch, 0.0, &synthetic(&ch, &taus, 0.0)).unwrap().metrics;
+        let m = compute(&ch, 0.0, &synthetic(&ch, &taus, 0.0), None).unwrap().metrics;
         assert!(m["u_profile_l2_rel_steady"] < 1e-7, "{m:?}");
         assert!(m["u_profile_l2_rel_t005"] < 1e-6);
-        let m = compute(&ch, 0.0, &synthetic(&ch, &taus, 0.01)).unwrap().metrics;
+        let m = compute(&ch, 0.0, &synthetic(&ch, &taus, 0.01), None).unwrap().metrics;
         for name in ["u_profile_l2_rel_t005", "u_profile_l2_rel_t050", "u_profile_l2_rel_steady"] {
             assert!((m[name] - 0.01).abs() < 1e-6, "{name} = {}", m[name]);
         }
@@ -211,9 +228,29 @@ mod tests {
                 v[3] *= 1.02;
             }
         }
-        let m = compute(&ch, 0.0, &p).unwrap().metrics;
+        let m = compute(&ch, 0.0, &p, None).unwrap().metrics;
         assert!((m["u_profile_drift"] - 0.02).abs() < 1e-4, "{}", m["u_profile_drift"]);
         assert!((m["tau_final"] - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_steady_stop_before_tau_one_gives_the_steady_metrics_there() {
+        let ch = PlanePoiseuille::new(0.2, 6e-8, 1e-6).unwrap();
+        let mut p = synthetic(&ch, &[0.5, 0.6, 0.68], 0.0);
+        // 1 % off at the stop only: measured against the series at τ = 0.68.
+        for (name, v) in p.series.get_mut(PROFILE).unwrap().iter_mut() {
+            if name.starts_with("u_") {
+                v[2] *= 1.01;
+            }
+        }
+        let stop = 0.68 * ch.viscous_time();
+        let m = compute(&ch, 0.0, &p, Some(stop)).unwrap().metrics;
+        assert!((m["u_profile_l2_rel_steady"] - 0.01).abs() < 1e-9, "{m:?}");
+        assert!((m["tau_steady"] - 0.68).abs() < 1e-12);
+        assert!(m["u_profile_l2_rel_startup_max"] < 1e-9, "the start-up samples are exact");
+        // A run that ended there for another reason has no steady value.
+        let m = compute(&ch, 0.0, &p, None).unwrap().metrics;
+        assert!(!m.contains_key("u_profile_l2_rel_steady") && !m.contains_key("tau_steady"));
     }
 
     #[test]
@@ -221,7 +258,7 @@ mod tests {
         let ch = PlanePoiseuille::new(0.2, 6e-8, 1e-6).unwrap();
         let mut p = synthetic(&ch, &[1.0], 0.0);
         p.series.get_mut(PROFILE).unwrap().get_mut("u_003").unwrap()[0] = f64::NAN;
-        let m = compute(&ch, 0.0, &p).unwrap().metrics;
+        let m = compute(&ch, 0.0, &p, None).unwrap().metrics;
         assert!(m["u_profile_l2_rel_steady"].is_nan());
     }
 

@@ -362,9 +362,14 @@ impl Base {
             }
         };
         let probes = meniscus::ProbeRecord::from(record.probes.clone());
-        let measured =
-            crate::metrics::compute(&self.case.reference, &record.scene, &probes, record.summary.particles)
-                .map_err(|source| HarnessError::Reference { case: NAME.into(), source })?;
+        let measured = crate::metrics::compute(
+            &self.case.reference,
+            &record.scene,
+            &probes,
+            record.summary.particles,
+            record.summary.steady_at,
+        )
+        .map_err(|source| HarnessError::Reference { case: NAME.into(), source })?;
         let error = match self.kind {
             Kind::Drop => {
                 let a = measured.metrics.get("a_rel_err_max").copied().unwrap_or(f64::NAN);

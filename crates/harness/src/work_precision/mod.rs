@@ -243,7 +243,7 @@ pub(crate) fn measure(case: &Case, ran: &Ran) -> Result<Measured> {
         return Ok(Measured { cost, status, metrics: BTreeMap::new() });
     }
     let probes = meniscus::ProbeRecord::from(record.probes.clone());
-    let measured = metrics::compute(&case.reference, &record.scene, &probes, s.particles)
+    let measured = metrics::compute(&case.reference, &record.scene, &probes, s.particles, s.steady_at)
         .map_err(|source| crate::error::HarnessError::Reference { case: case.case.clone(), source })?;
     let metrics = measured.metrics.into_iter().filter(|(_, v)| v.is_finite()).collect();
     Ok(Measured { cost, status, metrics })
