@@ -4,7 +4,7 @@
 //! Everything here but [`load`] is a pure function over [`CaseResults`].
 //!
 //! Rules (stated on every page that shows a comparison, see [`NoiseBand::describe`]):
-//! - Runs are matched by (scheme, preset, dx); dx to 1e-9 relative.
+//! - Runs are matched by (scheme, preset, dx, perturbed start); dx to 1e-9 relative.
 //! - A metric *changed* when its change is beyond the noise band: relative change above
 //!   5 % of the baseline value **and** absolute change above 1e-6.
 //! - Direction: lower is better for error metrics (the name contains `err`) and drifts
@@ -48,7 +48,7 @@ impl NoiseBand {
              and by more than {abs:e} in absolute terms. Lower is better for error metrics \
              (name contains \"err\") and drifts (name contains \"drift\"); other metrics and observed \
              orders are only marked changed. Wall time is the ratio now / baseline, flagged when \
-             it moved by more than {wall} %. Runs are matched by scheme, preset and dx.",
+             it moved by more than {wall} %. Runs are matched by scheme, preset, dx and perturbed start.",
             rel = self.rel * 100.0,
             abs = self.abs,
             wall = self.wall * 100.0,
@@ -516,6 +516,18 @@ mod tests {
         assert_eq!(classify("a_rel_err_max", Some(1e-9), Some(2e-9), &b), Mark::Unchanged);
         // From zero: beyond the floor counts.
         assert_eq!(classify("a_rel_err_max", Some(0.0), Some(1e-3), &b), Mark::Worse);
+    }
+
+    #[test]
+    fn a_perturbed_start_is_a_run_of_its_own() {
+        let run = |start: Option<u64>| -> RunResult {
+            serde_json::from_value(serde_json::json!({"scheme": "isph", "preset": "long", "dx": 0.02,
+                "start": start, "particles": 1, "steps": 1, "wall_s": 1.0, "status": "ok",
+                "metrics": {}, "series": {}}))
+            .unwrap()
+        };
+        assert!(same_run(&run(None), &run(None)) && same_run(&run(Some(1)), &run(Some(1))));
+        assert!(!same_run(&run(None), &run(Some(1))) && !same_run(&run(Some(1)), &run(Some(2))));
     }
 
     #[test]

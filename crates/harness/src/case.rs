@@ -385,7 +385,7 @@ impl Case {
         }
         for p in &self.sweep.presets {
             if let Some(s) = &p.perturbed_starts {
-                self.check_starts(s)
+                self.check_starts(p, s)
                     .map_err(|m| err(format!("preset `{}`: `perturbed_starts.{m}", p.name)))?;
             }
         }
@@ -411,9 +411,17 @@ impl Case {
 }
 
 impl Case {
-    /// A preset's perturbed starts are well formed; the message begins with the field.
-    fn check_starts(&self, s: &PerturbedStarts) -> std::result::Result<(), String> {
-        let all: Vec<f64> = self.sweep.dx.values().flatten().copied().collect();
+    /// A preset's perturbed starts are well formed and run somewhere; the message begins
+    /// with the field.
+    fn check_starts(&self, p: &Preset, s: &PerturbedStarts) -> std::result::Result<(), String> {
+        // The spacings of the tiers the preset runs in.
+        let all: Vec<f64> = self
+            .sweep
+            .dx
+            .iter()
+            .filter(|(tier, _)| p.tiers.as_ref().is_none_or(|t| t.contains(tier)))
+            .flat_map(|(_, dx)| dx.iter().copied())
+            .collect();
         if s.reason.trim().is_empty() {
             return Err("reason` is empty: say what a bit-level change of the start redraws".into());
         }
@@ -421,7 +429,7 @@ impl Case {
             return Err("dx` is empty: give the spacings of the ensemble".into());
         }
         if let Some(d) = s.dx.iter().find(|&&d| !listed(&all, d)) {
-            return Err(format!("dx` has {d}, not a spacing of `sweep.dx`"));
+            return Err(format!("dx` has {d}, not a spacing of a tier the preset runs in (`sweep.dx`)"));
         }
         let mut seeds = s.seeds.clone();
         seeds.sort_unstable();

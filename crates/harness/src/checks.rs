@@ -287,7 +287,8 @@ impl CheckSpec {
         };
         if !diverged.is_empty() {
             result.pass = false;
-            result.note = Some(format!("diverged: {}", diverged.join("; ")));
+            let note = format!("diverged: {}", diverged.join("; "));
+            result.note = Some(result.note.map_or(note.clone(), |n| format!("{note}; {n}")));
         }
         result.expected_failure = self.expected_failure.clone();
         Some(result)
@@ -348,12 +349,12 @@ fn by_group(runs: &[&RunResult], metric: &str) -> Groups {
 
 /// The metric of `runs` (one preset) at each of their spacings, coarse to fine: the value
 /// of the run there, or the mean over its perturbed starts (`perturbed_starts`), so a fit
-/// through the points judges the ensemble, not one draw; `None` where a member lacks a
-/// finite value.
+/// through the points judges the ensemble, not one draw; `None` where a member diverged
+/// or lacks a finite value.
 pub fn per_spacing(runs: &[&RunResult], metric: &str) -> Vec<(f64, Option<f64>)> {
     let mut out: Vec<(f64, Vec<Option<f64>>)> = Vec::new();
     for r in runs {
-        let v = r.metric(metric).filter(|v| v.is_finite());
+        let v = r.metric(metric).filter(|v| v.is_finite() && r.ok());
         match out.iter_mut().find(|(d, _)| (d - r.dx).abs() <= 1e-9 * d.abs()) {
             Some((_, vs)) => vs.push(v),
             None => out.push((r.dx, vec![v])),
@@ -369,16 +370,24 @@ pub fn per_spacing(runs: &[&RunResult], metric: &str) -> Vec<(f64, Option<f64>)>
 }
 
 /// The spread of a bound check's runs that are perturbed starts of one another: "over N
-/// starts: min – max" for each spacing and preset with more than one member.
+/// starts: min – max" for each spacing and preset that has perturbed starts among the runs
+/// and whose members differ.
 fn spread(runs: &[&RunResult], metric: &str) -> Option<String> {
     let mut members: BTreeMap<String, Vec<f64>> = BTreeMap::new();
+    let perturbed: Vec<String> = runs
+        .iter()
+        .filter(|r| r.start.is_some())
+        .map(|r| crate::results::slug(&r.scheme, &r.preset, r.dx))
+        .collect();
     for r in runs {
         let key = crate::results::slug(&r.scheme, &r.preset, r.dx);
-        members.entry(key).or_default().extend(r.metric(metric).filter(|v| v.is_finite()));
+        if perturbed.contains(&key) {
+            members.entry(key).or_default().extend(r.metric(metric).filter(|v| v.is_finite()));
+        }
     }
     let parts: Vec<String> = members
         .into_iter()
-        .filter(|(_, vs)| vs.len() > 1)
+        .filter(|(_, vs)| vs.len() > 1 && vs.iter().any(|v| v.to_bits() != vs[0].to_bits()))
         .map(|(slug, vs)| {
             let lo = vs.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = vs.iter().copied().fold(f64::NEG_INFINITY, f64::max);

@@ -114,7 +114,7 @@ pub struct Convergence {
     pub preset: String,
     /// Spacings used \[m\].
     pub dx: Vec<f64>,
-    /// The metric at those spacings.
+    /// The metric at those spacings (the mean over a preset's perturbed starts).
     pub values: Vec<f64>,
     /// Orders of every preset with at least two spacings.
     #[serde(default)]
@@ -300,7 +300,8 @@ pub struct CheckResult {
     pub threshold: Option<f64>,
     /// Whether it passed.
     pub pass: bool,
-    /// Why it failed when not because of the value (diverged run, missing metric).
+    /// Why it failed when not because of the value (diverged run, missing metric), and the
+    /// spread of a bound over perturbed starts.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
     /// Why the case file expects it to fail (the scheme's documented shortfall), if it does.

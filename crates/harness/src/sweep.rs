@@ -89,14 +89,15 @@ pub fn effective_scene(case: &Case, preset: &str, dx: f64) -> Result<serde_json:
     Ok(scene)
 }
 
+/// The scheme of an effective scene (the key of its `scheme` object; the case's when absent).
+fn scheme_of(case: &Case, scene: &serde_json::Value) -> String {
+    scene["scheme"].as_object().and_then(|m| m.keys().next().cloned()).unwrap_or_else(|| case.scheme.clone())
+}
+
 /// Builds the run of `preset` at `dx` (the scene is checked by the solver's parser).
 pub fn spec(case: &Case, preset: &str, dx: f64) -> Result<RunSpec> {
     let value = effective_scene(case, preset, dx)?;
-    let scheme = value["scheme"]
-        .as_object()
-        .and_then(|m| m.keys().next().cloned())
-        .unwrap_or_else(|| case.scheme.clone());
-    RunSpec::from_json(&case.case, slug(&scheme, preset, dx), preset, dx, &value)
+    RunSpec::from_json(&case.case, slug(&scheme_of(case, &value), preset, dx), preset, dx, &value)
 }
 
 /// The solver's fingerprint (SHA-256 of its sources, manifest, `Cargo.lock` and the
@@ -111,22 +112,30 @@ pub fn build_fingerprint() -> &'static str {
 /// (`perturbed_starts`): every fluid body's lattice jittered by `fraction · dx`.
 pub fn perturbed_spec(case: &Case, preset: &str, dx: f64, seed: u64) -> Result<RunSpec> {
     let mut value = effective_scene(case, preset, dx)?;
-    let fraction = case
+    let Some(fraction) = case
         .sweep
         .presets
         .iter()
         .find(|p| p.name == preset)
         .and_then(|p| p.perturbed_starts.as_ref())
-        .map_or(1e-12, |s| s.fraction);
-    let base = spec(case, preset, dx)?;
-    let slug = start_slug(&base.slug, Some(seed));
-    let Some(bodies) = value["bodies"].as_array_mut() else {
+        .map(|s| s.fraction)
+    else {
+        return Err(HarnessError::case(&case.case, format!("preset `{preset}` has no `perturbed_starts`")));
+    };
+    let slug = start_slug(&slug(&scheme_of(case, &value), preset, dx), Some(seed));
+    let fluid: Vec<&mut serde_json::Value> = value["bodies"]
+        .as_array_mut()
+        .map(|bodies| bodies.iter_mut().filter(|b| b["role"] == "fluid").collect())
+        .unwrap_or_default();
+    if fluid.is_empty() {
         return Err(HarnessError::case(
             &case.case,
-            format!("run {slug}: the scene has no `bodies` to perturb"),
+            format!(
+                "run {slug}: `perturbed_starts` jitters the bodies with role `fluid`; the scene has none"
+            ),
         ));
-    };
-    for body in bodies.iter_mut().filter(|b| b["role"] == "fluid") {
+    }
+    for body in fluid {
         if body.get("jitter").is_some() {
             return Err(HarnessError::case(
                 &case.case,
@@ -241,6 +250,23 @@ mod tests {
             let e = Case::from_json(&v.to_string(), std::path::Path::new("x.json")).unwrap_err().to_string();
             assert!(e.contains(field) && e.contains("`paper`"), "{field}: {e}");
         }
+        // A spacing of a tier the preset does not run in would never run.
+        v["sweep"]["presets"][0]["tiers"] = serde_json::json!(["quick"]);
+        v["sweep"]["presets"][0]["perturbed_starts"] =
+            serde_json::json!({"dx": [0.005], "seeds": [1], "reason": "r"});
+        let e = Case::from_json(&v.to_string(), std::path::Path::new("x.json")).unwrap_err().to_string();
+        assert!(e.contains("perturbed_starts.dx") && e.contains("0.005"), "{e}");
+        // The start jitters the fluid: a fluid body with its own jitter, or none, is an error.
+        let mut jittered = c.clone();
+        jittered.scene["bodies"][0]["jitter"] = serde_json::json!({"fraction": 0.1, "seed": 3});
+        let e = expand(&jittered, Tier::Quick).unwrap_err().to_string();
+        assert!(e.contains("isph-paper_dx0.02_start1") && e.contains("already has `jitter`"), "{e}");
+        let mut dry = c.clone();
+        dry.scene["bodies"][0]["role"] = serde_json::json!("wall");
+        let e = perturbed_spec(&dry, "paper", 0.02, 1).unwrap_err().to_string();
+        assert!(e.contains("role `fluid`"), "{e}");
+        let e = perturbed_spec(&dry, "tuned", 0.02, 1).unwrap_err().to_string();
+        assert!(e.contains("`tuned` has no `perturbed_starts`"), "{e}");
     }
 
     #[test]

@@ -100,7 +100,9 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
             let jobs = sweep::expand(case, opts.tier)?
                 .into_iter()
                 .map(|spec| {
-                    let previous = measured.get(&spec.slug).copied();
+                    // A perturbed start costs what its unperturbed run cost.
+                    let unperturbed = crate::results::slug(&spec.scheme, &spec.preset, spec.dx);
+                    let previous = measured.get(&spec.slug).or_else(|| measured.get(&unperturbed)).copied();
                     plan(spec, previous)
                 })
                 .collect();
@@ -332,7 +334,7 @@ pub fn convergence(case: &Case, runs: &[RunResult]) -> BTreeMap<String, Converge
         presets.sort_unstable();
         presets.dedup();
         for preset in presets {
-            let mine: Vec<&RunResult> = runs.iter().filter(|r| r.preset == preset && r.ok()).collect();
+            let mine: Vec<&RunResult> = runs.iter().filter(|r| r.preset == preset).collect();
             let pts = crate::checks::per_spacing(&mine, metric);
             let (dx, e): (Vec<f64>, Vec<f64>) = pts.iter().filter_map(|&(d, v)| Some((d, v?))).unzip();
             if let Some(fit) = fit_power_law(&dx, &e) {

@@ -251,6 +251,12 @@ mod tests {
         // A run that ended there for another reason has no steady value.
         let m = compute(&ch, 0.0, &p, None).unwrap().metrics;
         assert!(!m.contains_key("u_profile_l2_rel_steady") && !m.contains_key("tau_steady"));
+        // A stop at τ = 1 is the τ = 1 sample, and a stop time that matches no sample is none.
+        let full = synthetic(&ch, &[0.5, 1.0], 0.0);
+        let m = compute(&ch, 0.0, &full, Some(ch.viscous_time())).unwrap().metrics;
+        assert!(m["u_profile_l2_rel_steady"] < 1e-9 && !m.contains_key("tau_steady"), "{m:?}");
+        let m = compute(&ch, 0.0, &p, Some(0.65 * ch.viscous_time())).unwrap().metrics;
+        assert!(!m.contains_key("u_profile_l2_rel_steady"), "{m:?}");
     }
 
     #[test]

@@ -258,6 +258,11 @@ pub(crate) fn resolutions(runs: &[RunResult]) -> String {
 }
 
 /// A spacing as text: as written when short (`0.02`), else to 4 significant digits
+/// Spacings as `0.02, 0.01` ([`format_dx`] each).
+fn dx_list(dx: &[f64]) -> String {
+    dx.iter().map(|&d| format_dx(d)).collect::<Vec<_>>().join(", ")
+}
+
 /// (`5.556e-3` for D/36).
 pub fn format_dx(dx: f64) -> String {
     let plain = dx.to_string();
@@ -317,7 +322,7 @@ pub fn case_page(
         }
         @if !results.convergence.is_empty() {
             h2 { "Observed orders" }
-            p { "Least-squares fit of log(error) against log(dx) over the completed runs." }
+            p { "Least-squares fit of log(error) against log(dx) over the completed runs (at a spacing with perturbed starts, their mean)." }
             table {
                 tr { th class="l" { "metric" } th class="l" { "preset" } th { "order" } th class="l" { "other presets" } }
                 @for (m, c) in &results.convergence {
@@ -353,11 +358,11 @@ pub fn case_page(
             @for p in &c.sweep.presets {
                 p { b { (p.name) } @if !p.description.is_empty() { " — " (p.description) } }
                 @if let Some(e) = &p.expected_divergence {
-                    p class="note" { "Expected to diverge at dx = " (format!("{:?}", e.dx)) ": " (e.reason) }
+                    p class="note" { "Expected to diverge at dx = " (dx_list(&e.dx)) ": " (e.reason) }
                 }
                 @if let Some(s) = &p.perturbed_starts {
                     p class="note" {
-                        "Perturbed starts at dx = " (format!("{:?}", s.dx)) ": seeds " (format!("{:?}", s.seeds))
+                        "Perturbed starts at dx = " (dx_list(&s.dx)) ": seeds " (format!("{:?}", s.seeds))
                         ", lattice displaced by " (format!("{:e}", s.fraction)) " dx. " (s.reason)
                     }
                 }

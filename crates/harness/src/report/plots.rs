@@ -193,9 +193,10 @@ pub fn history(
                 let Some(v) = r.series.get(s) else { continue };
                 let pts = finite_points(&t, v);
                 let label = format!(
-                    "{s}, {} dx={}{}",
+                    "{s}, {} dx={}{}{}",
                     r.preset,
                     super::html::format_dx(r.dx),
+                    start_label(r),
                     if r.ok() { "" } else { " (diverged)" }
                 );
                 if j == 0 {
@@ -252,8 +253,9 @@ pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[Str
             let (r, c) = (runs[i], colour(i));
             let [s, reference] = &pairs[j];
             let label = format!(
-                "{s} vs {reference}, dx={}{}",
+                "{s} vs {reference}, dx={}{}{}",
                 super::html::format_dx(r.dx),
+                start_label(r),
                 if r.ok() { "" } else { " (diverged)" }
             );
             let width = if j == 0 { 2 } else { 1 };
@@ -274,6 +276,11 @@ pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[Str
     .map_err(plot_err(file))
 }
 
+/// `, start <seed>` for a perturbed start (legend labels), empty otherwise.
+fn start_label(r: &RunResult) -> String {
+    r.start.map(|seed| format!(", start {seed}")).unwrap_or_default()
+}
+
 /// Error against dx in log-log: one line per metric and preset (a perturbed-start ensemble
 /// by its mean), labelled with the fitted order, and a reference line of slope `slope` through the finest point of the first.
 pub fn convergence(
@@ -291,7 +298,7 @@ pub fn convergence(
     let mut lines = Vec::new();
     for (mi, m) in metrics.iter().enumerate() {
         for (pi, p) in presets.iter().enumerate() {
-            let mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p && r.ok()).collect();
+            let mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p).collect();
             let pts: Vec<(f64, f64)> = crate::checks::per_spacing(&mine, m)
                 .into_iter()
                 .filter_map(|(d, v)| Some((d, v?)))
