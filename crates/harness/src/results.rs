@@ -76,8 +76,7 @@ impl RunResult {
     /// CPU cost of one particle-step \[core-µs\]: `cpu_s / (particles × steps)` (none
     /// without a CPU time or a step).
     pub fn core_us_per_particle_step(&self) -> Option<f64> {
-        let work = (self.particles * self.steps) as f64;
-        self.cpu_s.filter(|_| work > 0.0).map(|cpu| cpu / work * 1e6)
+        core_us_per_particle_step(self.cpu_s, (self.particles * self.steps) as f64)
     }
 
     /// [`RunResult::core_us_per_particle_step`] over [`FLOOR_CORE_US_PER_PARTICLE_PASS`].
@@ -91,6 +90,51 @@ impl RunResult {
 /// threads, 0.107 core-µs per particle. A run's cost per particle-step over it is the
 /// number of such passes its step is worth.
 pub const FLOOR_CORE_US_PER_PARTICLE_PASS: f64 = 420.0 * 2.0 / 7860.0;
+
+/// CPU cost of one particle-step \[core-µs\]: `cpu_s / particle_steps` (none without a CPU
+/// time or any particle-step).
+pub fn core_us_per_particle_step(cpu_s: Option<f64>, particle_steps: f64) -> Option<f64> {
+    cpu_s.filter(|_| particle_steps > 0.0).map(|cpu| cpu / particle_steps * 1e6)
+}
+
+/// Summed times of a set of runs.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Totals {
+    /// Runs.
+    pub runs: usize,
+    /// Summed wall times \[s\].
+    pub wall_s: f64,
+    /// Summed CPU times of the runs that measured one \[s\].
+    pub cpu_s: f64,
+    /// Runs without a CPU time (run before it was measured, or off Linux).
+    pub without_cpu: usize,
+    /// Summed particles × steps.
+    pub particle_steps: f64,
+}
+
+impl Totals {
+    /// The totals of `runs`.
+    pub fn of<'a>(runs: impl IntoIterator<Item = &'a RunResult>) -> Self {
+        runs.into_iter().fold(Totals::default(), |mut t, r| {
+            t.runs += 1;
+            t.wall_s += r.wall_s;
+            match r.cpu_s {
+                Some(c) => t.cpu_s += c,
+                None => t.without_cpu += 1,
+            }
+            t.particle_steps += (r.particles * r.steps) as f64;
+            t
+        })
+    }
+
+    /// CPU cost of one particle-step \[core-µs\] (none without CPU times or steps).
+    pub fn core_us_per_particle_step(&self) -> Option<f64> {
+        if self.without_cpu > 0 {
+            return None;
+        }
+        core_us_per_particle_step(Some(self.cpu_s), self.particle_steps)
+    }
+}
 
 /// The stable slug of a run: `<scheme>-<preset>_dx<dx>` (dx in shortest decimal form).
 pub fn slug(scheme: &str, preset: &str, dx: f64) -> String {
@@ -229,6 +273,7 @@ impl CaseSummary {
     /// Summarises one case's results.
     pub fn of(results: &CaseResults) -> Self {
         let (passed, failed) = results.counts();
+        let t = Totals::of(&results.runs);
         CaseSummary {
             case: results.case.clone(),
             scheme: results.scheme.clone(),
@@ -239,9 +284,9 @@ impl CaseSummary {
             failed,
             expected_failures: expected_failures(&results.checks),
             pass: failed == 0,
-            wall_s: results.runs.iter().map(|r| r.wall_s).sum(),
-            cpu_s: results.runs.iter().filter_map(|r| r.cpu_s).reduce(|a, b| a + b),
-            particle_steps: results.runs.iter().map(|r| (r.particles * r.steps) as u64).sum(),
+            wall_s: t.wall_s,
+            cpu_s: (t.runs > t.without_cpu).then_some(t.cpu_s),
+            particle_steps: t.particle_steps as u64,
         }
     }
 }

@@ -396,27 +396,41 @@ pub fn case_page(
     page(&format!("Meniscus validation: {}", results.case), body)
 }
 
-/// Key errors of a case for the index: each key metric at the finest completed run of the
-/// primary preset.
+/// Key errors of a case for the index: each key metric at the finest completed spacing of
+/// the primary preset; where that spacing has perturbed starts, their mean (as the order
+/// fits and convergence plots take it) with the members' range.
 pub(crate) fn key_errors(results: &CaseResults, record: Option<&CaseRecord>) -> String {
     let keys: Vec<String> = record.map(|r| r.case.key_metrics.clone()).unwrap_or_default();
     let primary = record
         .map(|r| r.case.primary_preset().to_string())
         .or_else(|| results.runs.first().map(|r| r.preset.clone()));
-    let finest = results
-        .runs
+    let ok: Vec<_> = results.runs.iter().filter(|r| r.ok() && Some(&r.preset) == primary.as_ref()).collect();
+    let Some(finest) = ok.iter().map(|r| r.dx).min_by(f64::total_cmp) else {
+        return "—".to_string();
+    };
+    let members: Vec<_> = ok.into_iter().filter(|r| (r.dx - finest).abs() <= 1e-9 * finest.abs()).collect();
+    let first = members[0];
+    let keys = if keys.is_empty() { first.metrics.keys().take(2).cloned().collect() } else { keys };
+    let parts: Vec<String> = keys
         .iter()
-        .filter(|r| r.ok() && Some(&r.preset) == primary.as_ref())
-        .min_by(|a, b| a.dx.total_cmp(&b.dx));
-    match finest {
-        None => "—".to_string(),
-        Some(run) => {
-            let keys = if keys.is_empty() { run.metrics.keys().take(2).cloned().collect() } else { keys };
-            let parts: Vec<String> =
-                keys.iter().map(|k| format!("{k} {}", format_metric(k, run.metric(k)))).collect();
-            format!("{} ({} dx={})", parts.join(", "), run.preset, format_dx(run.dx))
-        }
-    }
+        .map(|k| {
+            let values: Vec<f64> = members.iter().filter_map(|r| r.metric(k)).collect();
+            if members.len() == 1 || values.len() != members.len() || values.iter().any(|v| !v.is_finite()) {
+                return format!("{k} {}", format_metric(k, first.metric(k)));
+            }
+            let mean = values.iter().sum::<f64>() / values.len() as f64;
+            let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+            format!(
+                "{k} {} (mean of {} starts, {} – {})",
+                format_metric(k, Some(mean)),
+                values.len(),
+                format_metric(k, Some(lo)),
+                format_metric(k, Some(hi))
+            )
+        })
+        .collect();
+    format!("{} ({} dx={})", parts.join(", "), first.preset, format_dx(first.dx))
 }
 
 /// The order shown on the index: the first convergence metric of the case.
@@ -539,5 +553,39 @@ mod tests {
         assert_eq!(format_dx(0.02), "0.02");
         assert_eq!(format_dx(0.0025), "0.0025");
         assert_eq!(format_dx(0.2 / 36.0), "5.556e-3");
+    }
+
+    #[test]
+    fn key_errors_take_the_finest_spacing_and_its_starts_mean() {
+        let run = |dx: f64, start: Option<u64>, err: f64| RunResult {
+            scheme: "isph".into(),
+            preset: "p".into(),
+            dx,
+            start,
+            particles: 100,
+            steps: 10,
+            wall_s: 1.0,
+            cpu_s: None,
+            threads: None,
+            steady_at: None,
+            status: "ok".into(),
+            metrics: [("u_l2_rel".to_string(), err)].into(),
+            series: Default::default(),
+        };
+        let mut results = CaseResults {
+            case: "c".into(),
+            scheme: "isph".into(),
+            tier: "default".into(),
+            runs: vec![run(0.02, None, 0.01), run(0.01, None, 0.002)],
+            convergence: Default::default(),
+            checks: Vec::new(),
+        };
+        assert_eq!(key_errors(&results, None), "u_l2_rel 0.200 % (p dx=0.01)");
+        results.runs.push(run(0.01, Some(1), 0.004));
+        results.runs.push(run(0.01, Some(2), 0.003));
+        assert_eq!(
+            key_errors(&results, None),
+            "u_l2_rel 0.300 % (mean of 3 starts, 0.200 % – 0.400 %) (p dx=0.01)"
+        );
     }
 }

@@ -8,48 +8,12 @@
 //! ([`FLOOR_CORE_US_PER_PARTICLE_PASS`]: one fused pair pass) says how many such passes a
 //! step is worth. Times of cached runs are those measured when they ran.
 
-use crate::results::{CaseResults, FLOOR_CORE_US_PER_PARTICLE_PASS, RunResult};
+use crate::results::{CaseResults, FLOOR_CORE_US_PER_PARTICLE_PASS, RunResult, Totals};
 use maud::{Markup, html};
 use std::fmt::Write;
 
 /// How many of the costliest runs the tables list.
 pub const TOP: usize = 10;
-
-/// Summed times of a set of runs.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
-pub struct Totals {
-    /// Runs.
-    pub runs: usize,
-    /// Summed wall times \[s\].
-    pub wall_s: f64,
-    /// Summed CPU times of the runs that measured one \[s\].
-    pub cpu_s: f64,
-    /// Runs without a CPU time (run before it was measured, or off Linux).
-    pub without_cpu: usize,
-    /// Summed particles × steps.
-    pub particle_steps: f64,
-}
-
-impl Totals {
-    /// The totals of `runs`.
-    pub fn of<'a>(runs: impl IntoIterator<Item = &'a RunResult>) -> Self {
-        runs.into_iter().fold(Totals::default(), |mut t, r| {
-            t.runs += 1;
-            t.wall_s += r.wall_s;
-            match r.cpu_s {
-                Some(c) => t.cpu_s += c,
-                None => t.without_cpu += 1,
-            }
-            t.particle_steps += (r.particles * r.steps) as f64;
-            t
-        })
-    }
-
-    /// CPU cost of one particle-step \[core-µs\] (none without CPU times or steps).
-    pub fn core_us_per_particle_step(&self) -> Option<f64> {
-        (self.without_cpu == 0 && self.particle_steps > 0.0).then(|| self.cpu_s / self.particle_steps * 1e6)
-    }
-}
 
 /// A run with its case.
 pub type CaseRun<'a> = (&'a str, &'a RunResult);

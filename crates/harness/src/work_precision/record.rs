@@ -69,8 +69,7 @@ impl Cost {
 
     /// CPU cost of one particle-step \[core-µs\] (none without a CPU time or a step).
     pub fn core_us_per_particle_step(&self) -> Option<f64> {
-        let work = (self.particles * self.steps) as f64;
-        self.cpu_s.filter(|_| work > 0.0).map(|cpu| cpu / work * 1e6)
+        crate::results::core_us_per_particle_step(self.cpu_s, (self.particles * self.steps) as f64)
     }
 }
 
