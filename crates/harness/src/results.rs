@@ -127,6 +127,11 @@ impl Totals {
         })
     }
 
+    /// Summed CPU time \[s\] when at least one run measured one (none otherwise).
+    pub fn measured_cpu_s(&self) -> Option<f64> {
+        (self.runs > self.without_cpu).then_some(self.cpu_s)
+    }
+
     /// CPU cost of one particle-step \[core-µs\] (none without CPU times or steps).
     pub fn core_us_per_particle_step(&self) -> Option<f64> {
         if self.without_cpu > 0 {
@@ -285,7 +290,7 @@ impl CaseSummary {
             expected_failures: expected_failures(&results.checks),
             pass: failed == 0,
             wall_s: t.wall_s,
-            cpu_s: (t.runs > t.without_cpu).then_some(t.cpu_s),
+            cpu_s: t.measured_cpu_s(),
             particle_steps: t.particle_steps as u64,
         }
     }

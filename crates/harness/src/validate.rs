@@ -191,41 +191,29 @@ pub const WIDE_PARTICLES: usize = 50_000;
 const CORE_S_PER_PARTICLE_STEP: f64 = 1.5e-6;
 
 /// The job of a run: its thread count from its particle count ([`WIDE_PARTICLES`]) and its
-/// cost in core-seconds. With `previous`, the same run's measured cost and particle count
-/// when the case's last results have them, nothing is built; otherwise the scene is built
-/// (before anything runs) and costed as `particles × end / Δt₀ × 1.5 core-µs` with the
-/// first step's Δt (a scene that cannot start is costed as zero, and its error is the
-/// run's). The estimate ranks a flow that starts from rest by its first, viscous-limited
-/// step, ten times too cheap for the periodic channel at Re 400
+/// cost in core-seconds: `previous`, the same run's measured cost when the case's last
+/// results have it; otherwise `particles × end / Δt₀ × 1.5 core-µs` with the first step's
+/// Δt (built from the scene before anything runs; a scene that cannot start is costed as
+/// zero, and its error is the run's). The estimate ranks a flow that starts from rest by
+/// its first, viscous-limited step, ten times too cheap for the periodic channel at Re 400
 /// (docs/notes/main-job-time.md); a measured cost ranks it right.
-fn plan(spec: RunSpec, previous: Option<Measured>) -> Job {
-    let (particles, cost) = match previous {
-        Some(m) => (m.particles, m.core_s),
-        None => {
-            let Ok(sim) = meniscus::AnySimulation::new(&spec.scene) else {
-                return Job::new(spec);
-            };
-            let particles = sim.particles();
-            let steps = sim.first_step().map_or(0.0, |dt| (spec.scene.time.end / dt).ceil());
-            (particles, particles as f64 * steps * CORE_S_PER_PARTICLE_STEP)
-        }
+fn plan(spec: RunSpec, previous: Option<f64>) -> Job {
+    let Ok(sim) = meniscus::AnySimulation::new(&spec.scene) else {
+        return Job::new(spec);
     };
+    let particles = sim.particles();
     let threads = (particles >= WIDE_PARTICLES).then(rayon::current_num_threads);
+    let cost = previous.unwrap_or_else(|| {
+        let steps = sim.first_step().map_or(0.0, |dt| (spec.scene.time.end / dt).ceil());
+        particles as f64 * steps * CORE_S_PER_PARTICLE_STEP
+    });
     Job { threads, cost, ..Job::new(spec) }
 }
 
-/// What a run cost when it last ran.
-#[derive(Debug, Clone, Copy)]
-struct Measured {
-    /// CPU time when measured, else wall time × threads \[core-s\].
-    core_s: f64,
-    /// Its particle count.
-    particles: usize,
-}
-
-/// What each run of a case cost when it last ran, by slug, from the case's `results.json`
-/// in `dir`; empty when there is no readable results file.
-fn measured_costs(dir: &Path) -> BTreeMap<String, Measured> {
+/// The core-seconds each run of a case took when it last ran, by slug, from the case's
+/// `results.json` in `dir` (CPU time when measured, else wall time × threads); empty when
+/// there is no readable results file.
+fn measured_costs(dir: &Path) -> BTreeMap<String, f64> {
     let Ok(previous) = io::read_json::<CaseResults>(&dir.join("results.json")) else {
         return BTreeMap::new();
     };
@@ -234,8 +222,7 @@ fn measured_costs(dir: &Path) -> BTreeMap<String, Measured> {
         .iter()
         .filter_map(|r| {
             let core_s = r.cpu_s.unwrap_or(r.wall_s * r.threads.unwrap_or(1) as f64);
-            (core_s > 0.0 && core_s.is_finite() && r.particles > 0)
-                .then(|| (r.slug(), Measured { core_s, particles: r.particles }))
+            (core_s > 0.0 && core_s.is_finite()).then(|| (r.slug(), core_s))
         })
         .collect()
 }
@@ -449,9 +436,8 @@ mod tests {
         io::write_json(&dir.path().join("results.json"), &results(vec![timed, untimed, unknown])).unwrap();
         let costs = measured_costs(dir.path());
         assert_eq!(costs.len(), 2, "{costs:?}");
-        assert!((costs["isph-paper_dx0.04"].core_s - 5.5).abs() < 1e-12, "CPU time when measured");
-        assert!((costs["isph-paper_dx0.02"].core_s - 4.0).abs() < 1e-12, "else wall time x threads");
-        assert_eq!(costs["isph-paper_dx0.02"].particles, 7860);
+        assert!((costs["isph-paper_dx0.04"] - 5.5).abs() < 1e-12, "CPU time when measured");
+        assert!((costs["isph-paper_dx0.02"] - 4.0).abs() < 1e-12, "else wall time x threads");
     }
 
     #[test]

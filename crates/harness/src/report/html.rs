@@ -396,38 +396,54 @@ pub fn case_page(
     page(&format!("Meniscus validation: {}", results.case), body)
 }
 
-/// Key errors of a case for the index: each key metric at the finest completed spacing of
-/// the primary preset; where that spacing has perturbed starts, their mean (as the order
-/// fits and convergence plots take it) with the members' range.
+/// Key errors of a case for the index: each key metric at the finest spacing of the primary
+/// preset that has a completed run. Where that spacing has perturbed starts, the value is
+/// their mean as the checks and order fits take it ([`crate::checks::per_spacing`]: none
+/// when a start diverged or lacks the metric, and the text says so) with the range of the
+/// starts that have it.
 pub(crate) fn key_errors(results: &CaseResults, record: Option<&CaseRecord>) -> String {
     let keys: Vec<String> = record.map(|r| r.case.key_metrics.clone()).unwrap_or_default();
     let primary = record
         .map(|r| r.case.primary_preset().to_string())
         .or_else(|| results.runs.first().map(|r| r.preset.clone()));
-    let ok: Vec<_> = results.runs.iter().filter(|r| r.ok() && Some(&r.preset) == primary.as_ref()).collect();
-    let Some(finest) = ok.iter().map(|r| r.dx).min_by(f64::total_cmp) else {
+    let runs: Vec<&RunResult> = results.runs.iter().filter(|r| Some(&r.preset) == primary.as_ref()).collect();
+    let Some(finest) = runs.iter().filter(|r| r.ok()).map(|r| r.dx).min_by(f64::total_cmp) else {
         return "—".to_string();
     };
-    let members: Vec<_> = ok.into_iter().filter(|r| (r.dx - finest).abs() <= 1e-9 * finest.abs()).collect();
-    let first = members[0];
+    let members: Vec<&RunResult> =
+        runs.into_iter().filter(|r| (r.dx - finest).abs() <= 1e-9 * finest.abs()).collect();
+    let first = members.iter().find(|r| r.ok()).copied().unwrap_or(members[0]);
     let keys = if keys.is_empty() { first.metrics.keys().take(2).cloned().collect() } else { keys };
     let parts: Vec<String> = keys
         .iter()
         .map(|k| {
-            let values: Vec<f64> = members.iter().filter_map(|r| r.metric(k)).collect();
-            if members.len() == 1 || values.len() != members.len() || values.iter().any(|v| !v.is_finite()) {
+            if members.len() == 1 {
                 return format!("{k} {}", format_metric(k, first.metric(k)));
             }
-            let mean = values.iter().sum::<f64>() / values.len() as f64;
+            let values: Vec<f64> = members
+                .iter()
+                .filter(|r| r.ok())
+                .filter_map(|r| r.metric(k))
+                .filter(|v| v.is_finite())
+                .collect();
             let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            format!(
-                "{k} {} (mean of {} starts, {} – {})",
-                format_metric(k, Some(mean)),
-                values.len(),
-                format_metric(k, Some(lo)),
-                format_metric(k, Some(hi))
-            )
+            let range = if values.is_empty() {
+                String::new()
+            } else {
+                format!(", {} – {}", format_metric(k, Some(lo)), format_metric(k, Some(hi)))
+            };
+            let mean = crate::checks::per_spacing(&members, k).first().and_then(|(_, m)| *m);
+            match mean {
+                Some(m) => {
+                    format!("{k} {} (mean of {} starts{range})", format_metric(k, Some(m)), members.len())
+                }
+                None => format!(
+                    "{k} — ({} of {} starts diverged or lack it{range})",
+                    members.len() - values.len(),
+                    members.len()
+                ),
+            }
         })
         .collect();
     format!("{} ({} dx={})", parts.join(", "), first.preset, format_dx(first.dx))
@@ -587,5 +603,16 @@ mod tests {
             key_errors(&results, None),
             "u_l2_rel 0.300 % (mean of 3 starts, 0.200 % – 0.400 %) (p dx=0.01)"
         );
+        // A start that diverged leaves the spacing without a mean, as in the order fits.
+        results.runs[3].status = "diverged".into();
+        assert_eq!(
+            key_errors(&results, None),
+            "u_l2_rel — (1 of 3 starts diverged or lack it, 0.200 % – 0.400 %) (p dx=0.01)"
+        );
+        // Every run at the finest spacing diverged: the next one down is shown.
+        for r in &mut results.runs[1..] {
+            r.status = "diverged".into();
+        }
+        assert_eq!(key_errors(&results, None), "u_l2_rel 1.000 % (p dx=0.02)");
     }
 }

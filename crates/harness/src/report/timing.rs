@@ -33,7 +33,7 @@ fn opt(v: Option<f64>, digits: usize) -> String {
 }
 
 fn cpu(t: &Totals) -> String {
-    if t.without_cpu == t.runs { "—".into() } else { format!("{:.1}", t.cpu_s) }
+    opt(t.measured_cpu_s(), 1)
 }
 
 /// Rate as text: `1.23e6`.
