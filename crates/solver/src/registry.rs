@@ -4,6 +4,7 @@
 use crate::error::SceneError;
 use crate::isph::Isph;
 use crate::kernel::{CubicSpline, Kernel, Scaled, WendlandC2};
+use crate::mps::Mps;
 use crate::probes::Weight;
 use crate::scene::{KernelKind, Scene, Scheme as SceneScheme};
 use crate::scheme::{Method, Scheme};
@@ -16,7 +17,8 @@ pub struct Built<const D: usize> {
     pub method: Box<dyn Method<D>>,
     /// The kernel, for the probes' kernel-weighted averages.
     pub weight: Weight,
-    /// The kernel support radius \[m\].
+    /// The radius of the scheme's neighbour lists \[m\] (the kernel support, or farther:
+    /// [`Scheme::reach`]).
     pub support: f64,
 }
 
@@ -25,6 +27,7 @@ pub fn compose<const D: usize>(scene: &Scene) -> Result<Built<D>, SceneError> {
     match &scene.scheme {
         SceneScheme::Isph(_) => compose_with::<D, Isph>(scene),
         SceneScheme::Wcsph(_) => compose_with::<D, Wcsph>(scene),
+        SceneScheme::Mps(_) => compose_with::<D, Mps>(scene),
     }
 }
 
@@ -38,10 +41,11 @@ pub fn compose_with<const D: usize, S: Scheme<D>>(scene: &Scene) -> Result<Built
 
 fn with_kernel<const D: usize, S: Scheme<D>, K: Kernel>(scene: &Scene) -> Result<Built<D>, SceneError> {
     let kernel = Scaled::<K, D>::new(scene.h());
-    let method = Box::new(S::build(scene, kernel)?);
+    let composed = S::build(scene, kernel)?;
+    let support = composed.scheme.reach(kernel.support);
     Ok(Built {
-        method,
+        method: Box::new(composed),
         weight: Weight { w: Box::new(move |r| kernel.w(r)), support: kernel.support },
-        support: kernel.support,
+        support,
     })
 }

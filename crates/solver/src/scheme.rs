@@ -39,6 +39,13 @@ pub trait Scheme<const D: usize>: Send + std::fmt::Debug + Sized + 'static {
     /// The largest stable step \[s\] at this state under the adaptive rule `rule`: the
     /// smallest of the scheme's stability limits.
     fn stable_step(&self, rule: Adaptive, state: &State<D>, own: &Self::Own) -> f64;
+
+    /// The radius of the scheme's neighbour lists \[m\] (the guard's overstep distance and
+    /// neighbour-count band): the kernel support `kernel_support` unless the scheme
+    /// searches farther.
+    fn reach(&self, kernel_support: f64) -> f64 {
+        kernel_support
+    }
 }
 
 /// A scheme with its state and stages: what a [`Method`] is.

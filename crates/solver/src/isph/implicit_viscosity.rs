@@ -124,7 +124,7 @@ impl<const D: usize, O> Stage<D, O> for ImplicitViscosity {
             });
             self.x.clear();
             self.x.extend(u[..n].iter().map(|u| u[k]));
-            self.solver.solve(&self.matrix, &self.rhs, &mut self.x, false).map_err(super::ppe::cause)?;
+            self.solver.solve(&self.matrix, &self.rhs, &mut self.x, false).map_err(crate::ppe::cause)?;
             for (u, &x) in u[..n].iter_mut().zip(&self.x) {
                 u[k] = x;
             }

@@ -25,7 +25,6 @@
 pub mod consistent_viscosity;
 pub mod implicit_viscosity;
 pub mod particle_density;
-pub mod ppe;
 pub mod predictor;
 pub mod projection;
 
@@ -67,7 +66,7 @@ pub struct Isph {
 #[derive(Debug, Default)]
 pub struct IsphData {
     /// The pressure Poisson system of the step.
-    pub ppe: ppe::PpeSystem,
+    pub ppe: crate::ppe::PpeSystem,
     /// ρ/ρ₀ by kernel summation (`particle_density`), computed each step before the PPE
     /// assembly that reads it; empty unless the density relaxation is on.
     pub particle_density: Vec<f64>,
@@ -214,7 +213,7 @@ fn build_stages<K: Kernel, const D: usize>(
         surface_pressure: young_laplace,
     }));
     // Only a `solver` probe reads the measured residual.
-    let solver = LinearSolver::new(ppe::solver_params(&opts.ppe))
+    let solver = LinearSolver::new(crate::ppe::solver_params(&opts.ppe))
         .measuring_residual(scene.probes.iter().any(|p| matches!(p, Probe::Solver {})));
     stages.push(Box::new(projection::PpeSolveStage { solver, surface_pressure: young_laplace }));
     if walls == Some(WallModel::Dummy) {

@@ -197,7 +197,7 @@ impl<const D: usize> Stage<D, IsphData> for PpeSolveStage {
         s.solve = self
             .solver
             .solve_keyed(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular, keys)
-            .map_err(super::ppe::cause)?;
+            .map_err(crate::ppe::cause)?;
         // Free-surface particles get p = 0 (or keep their Young–Laplace value); boundary
         // particles keep their known values.
         if !self.surface_pressure {

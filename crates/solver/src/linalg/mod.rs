@@ -5,7 +5,7 @@
 //! ([`LinearSolver`]), with their parameters ([`SolverParams`]), what a solve did
 //! ([`SolveInfo`]) and how it failed ([`SolveError`]) — faer's params / info / error
 //! habit. A scheme maps its scene options onto [`SolverParams`] (the PPE:
-//! `isph::ppe_params`; the implicit viscous system: fixed CG settings).
+//! `ppe::solver_params`; the implicit viscous system: fixed CG settings).
 
 pub mod csr;
 pub mod direct;

@@ -352,6 +352,10 @@ pub enum Scheme {
     /// Weakly compressible SPH (Xu 2016 with the standard forms of CASES.md erratum 6):
     /// continuity equation, Tait equation of state, kick-drift-kick integration.
     Wcsph(WcsphOptions),
+    /// Moving particle semi-implicit (Koshizuka & Oka 1996; Lan, Zhao & Wan 2022 eqs. 3–9
+    /// with the mixed source of Lee et al. 2011; MPS.md): number-density weights instead of
+    /// a kernel, a pressure Poisson equation per step, multi-layer wall particles.
+    Mps(MpsOptions),
 }
 
 impl Scheme {
@@ -360,8 +364,136 @@ impl Scheme {
         match self {
             Scheme::Isph(_) => "isph",
             Scheme::Wcsph(_) => "wcsph",
+            Scheme::Mps(_) => "mps",
         }
     }
+}
+
+/// Options of the moving particle semi-implicit scheme (see [`crate::mps`]). Lengths are
+/// in units of the initial spacing l0 = `dx`; the scene's `kernel` is used only by the
+/// optional shifting and the probes' kernel-weighted averages. Walls are always MPS wall
+/// particles (`boundaries.wall_model` must stay `mirror`, its default).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpsOptions {
+    /// Weight function w(r) of every operator.
+    #[serde(default)]
+    pub weight: MpsWeight,
+    /// Radius of each operator in units of l0 (default: Lan's 2.1 / 2.1 / 4.1 for the `lan`
+    /// weight, Koshizuka & Oka's 2.1 / 2.1 / 3.1 for `classic`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radii: Option<MpsRadii>,
+    /// Weight γ ∈ [0, 1] of the number-density term of the mixed PPE source (Lee et al.
+    /// 2011; Lan eq. 4): `(1 − γ)(ρ/Δt)⟨∇·u*⟩ − γ (ρ/Δt²)(n* − n0)/n0`. Lan prints 0.99; the
+    /// other MLParticle-SJTU papers use 0.01.
+    pub gamma: f64,
+    /// Quasi-compressibility α \[1/Pa\] (Tanaka & Masunaga 2010): `(ρ α/Δt²) P_i` on the
+    /// left of the PPE; 0 (the default) for none. Koshizuka's sample uses 0.45e-9.
+    #[serde(default)]
+    pub compressibility: f64,
+    /// Free-surface detection.
+    #[serde(default)]
+    pub free_surface: MpsFreeSurface,
+    /// Form of the pressure gradient of the velocity correction.
+    #[serde(default)]
+    pub pressure_gradient: MpsGradient,
+    /// Form of the velocity divergence of the PPE source.
+    #[serde(default)]
+    pub divergence: MpsDivergence,
+    /// Set negative pressures to zero before the correction (Koshizuka's sample code; off in
+    /// channels, where the pressure level is arbitrary).
+    #[serde(default)]
+    pub clip_negative_pressure: bool,
+    /// Particle shifting after the correction, the other schemes' stage (none if absent):
+    /// not part of Lan's MPS; the shift's neighbour sums use the scene's kernel.
+    #[serde(default)]
+    pub shifting: Shifting,
+    /// Pressure Poisson solver (CG: the matrix is symmetric positive definite).
+    pub ppe: PpeOptions,
+}
+
+/// Weight functions of the MPS operators.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MpsWeight {
+    /// Lan 2022 eq. 3 (Zhang 2014): `re/(0.85 r + 0.15 re) − 1`, finite at r = 0.
+    #[default]
+    Lan,
+    /// Koshizuka & Oka 1996: `re/r − 1`.
+    Classic,
+}
+
+/// Operator radii of MPS in units of l0 (each at least 1: the nearest neighbours).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpsRadii {
+    /// Particle number density and the free-surface test.
+    pub number_density: f64,
+    /// Gradient and divergence.
+    pub gradient: f64,
+    /// Laplacian (viscosity and the PPE).
+    pub laplacian: f64,
+}
+
+impl MpsWeight {
+    /// The weight's default radii (MPS.md): Lan 2.1 / 2.1 / 4.1, classic 2.1 / 2.1 / 3.1.
+    pub fn default_radii(self) -> MpsRadii {
+        let laplacian = match self {
+            MpsWeight::Lan => 4.1,
+            MpsWeight::Classic => 3.1,
+        };
+        MpsRadii { number_density: 2.1, gradient: 2.1, laplacian }
+    }
+}
+
+impl MpsOptions {
+    /// The operator radii in units of l0: the scene's, or the weight's defaults.
+    pub fn radii(&self) -> MpsRadii {
+        self.radii.unwrap_or_else(|| self.weight.default_radii())
+    }
+}
+
+/// Free-surface detection of MPS.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MpsFreeSurface {
+    /// β of the classic test `n* < β n0` (default 0.97 in 2D, 0.98 in 3D).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub beta: Option<f64>,
+    /// The auxiliary criterion of Zhang & Wan (Lan's ref. 15): surface if `n* < 0.8 n0`, or
+    /// if `n* ≤ β n0` and `|F_i| > 0.9 |F|0` with `F_i = (d/n0) Σ (r_i − r_j) w_ij/|r_ij|`
+    /// and `|F|0` its value at a flat surface of the initial lattice.
+    #[serde(default)]
+    pub auxiliary: bool,
+}
+
+/// Velocity divergence of the MPS PPE source.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MpsDivergence {
+    /// Lan eq. 7: `(d/n0) Σ (u_j − u_i)·r_ij w_ij/|r_ij|²`, exact for linear fields on the
+    /// undeformed lattice only.
+    #[default]
+    Lan,
+    /// `tr(Σ (u_j − u_i) ⊗ r_ij w/r² · [Σ r_ij ⊗ r_ij w/r²]⁻¹)`: the corrective matrix of
+    /// the gradient applied to the divergence, exact for linear fields on any arrangement.
+    Corrected,
+}
+
+/// Pressure gradient of the MPS velocity correction.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum MpsGradient {
+    /// Lan eq. 6: `(d/n0) Σ (P_j − P_i) r_ij w_ij/|r_ij|²`.
+    #[default]
+    Lan,
+    /// Koshizuka & Oka 1996: `P_j − P̂_i` with `P̂_i` the smallest pressure of the
+    /// neighbourhood (the particle included): every pair repels, which stabilises.
+    Minimum,
+    /// Lan's difference premultiplied by the corrective matrix
+    /// `C_i = [(d/n0) Σ w r⊗r/|r|²]⁻¹` (exact for linear pressure fields; the plain form
+    /// where the matrix is near singular).
+    Corrected,
 }
 
 /// Options of the weakly compressible scheme (see [`crate::wcsph`]).

@@ -111,6 +111,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
     match &scene.scheme {
         Scheme::Isph(o) => validate_isph(o, d)?,
         Scheme::Wcsph(o) => validate_wcsph(o)?,
+        Scheme::Mps(o) => validate_mps(o, scene)?,
     }
     validate_young_laplace(scene)?;
     positive("time.end", scene.time.end)?;
@@ -218,20 +219,7 @@ fn shape_measure(shape: &Shape) -> f64 {
 }
 
 fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
-    positive("scheme.isph.ppe.tolerance", o.ppe.tolerance)?;
-    if o.ppe.tolerance >= 1.0 {
-        return Err(SceneError::new(
-            "scheme.isph.ppe.tolerance",
-            o.ppe.tolerance,
-            "must be below 1 (a relative residual)",
-        ));
-    }
-    if o.ppe.max_iterations == 0 {
-        return Err(SceneError::new("scheme.isph.ppe.max_iterations", 0, "must be at least 1"));
-    }
-    if o.ppe.coarse_refresh == 0 {
-        return Err(SceneError::new("scheme.isph.ppe.coarse_refresh", 0, "must be at least 1"));
-    }
+    validate_ppe("scheme.isph.ppe", &o.ppe)?;
     let t = o.free_surface_threshold;
     positive("scheme.isph.free_surface_threshold", t)?;
     if t >= d as f64 {
@@ -260,6 +248,77 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
         ));
     }
     validate_shifting("scheme.isph.shifting", o.shifting)?;
+    Ok(())
+}
+
+/// The linear-solver rules of a PPE's options at `field`.
+fn validate_ppe(field: &str, ppe: &PpeOptions) -> Result<(), SceneError> {
+    let f = format!("{field}.tolerance");
+    positive(&f, ppe.tolerance)?;
+    if ppe.tolerance >= 1.0 {
+        return Err(SceneError::new(f, ppe.tolerance, "must be below 1 (a relative residual)"));
+    }
+    if ppe.max_iterations == 0 {
+        return Err(SceneError::new(format!("{field}.max_iterations"), 0, "must be at least 1"));
+    }
+    if ppe.coarse_refresh == 0 {
+        return Err(SceneError::new(format!("{field}.coarse_refresh"), 0, "must be at least 1"));
+    }
+    Ok(())
+}
+
+/// The rules of the MPS options (MPS.md) and of what the MPS step does not have.
+fn validate_mps(o: &MpsOptions, scene: &Scene) -> Result<(), SceneError> {
+    validate_ppe("scheme.mps.ppe", &o.ppe)?;
+    let r = o.radii();
+    for (name, re) in
+        [("number_density", r.number_density), ("gradient", r.gradient), ("laplacian", r.laplacian)]
+    {
+        let f = format!("scheme.mps.radii.{name}");
+        finite(&f, re)?;
+        if re <= 1.0 {
+            return Err(SceneError::new(
+                f,
+                re,
+                "must exceed 1 (a radius in units of l0 = dx: the weight must reach the nearest neighbours)",
+            ));
+        }
+        if re > 6.0 {
+            return Err(SceneError::new(f, re, "must be at most 6 (MPS uses 2.1 to 4.1)"));
+        }
+    }
+    if !(o.gamma.is_finite() && (0.0..=1.0).contains(&o.gamma)) {
+        return Err(SceneError::new(
+            "scheme.mps.gamma",
+            o.gamma,
+            "must lie in [0, 1] (the weight of the number-density term of the PPE source; Lan prints 0.99, others use 0.01)",
+        ));
+    }
+    non_negative("scheme.mps.compressibility", o.compressibility)?;
+    validate_shifting("scheme.mps.shifting", o.shifting)?;
+    if let Some(beta) = o.free_surface.beta
+        && !(beta.is_finite() && beta > 0.0 && beta < 1.0)
+    {
+        return Err(SceneError::new(
+            "scheme.mps.free_surface.beta",
+            beta,
+            "must lie in (0, 1) (surface where n* < β n0; 0.97 in 2D, 0.98 in 3D)",
+        ));
+    }
+    if scene.fluid.surface_tension > 0.0 {
+        return Err(SceneError::new(
+            "fluid.surface_tension",
+            scene.fluid.surface_tension,
+            "must be 0 with the mps scheme (it has no surface-tension model)",
+        ));
+    }
+    if scene.boundaries.wall_model == WallModel::Dummy && !scene.boundaries.walls.is_empty() {
+        return Err(SceneError::new(
+            "boundaries.wall_model",
+            "dummy",
+            "is not an mps wall: the mps scheme lays its own wall particles (MPS.md); leave wall_model unset",
+        ));
+    }
     Ok(())
 }
 
@@ -491,7 +550,7 @@ fn validate_young_laplace(scene: &Scene) -> Result<(), SceneError> {
             "young_laplace",
             "needs scheme.isph.pressure_gradient = \"difference\" or \"corrected\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)",
         )),
-        Scheme::Wcsph(_) => Err(SceneError::new(
+        Scheme::Wcsph(_) | Scheme::Mps(_) => Err(SceneError::new(
             "fluid.surface_tension_model",
             "young_laplace",
             "is for the projection scheme (isph) only: it sets the free-surface Dirichlet pressure",

@@ -1,6 +1,6 @@
-//! The pressure Poisson system of the projection (Qiu 2013 eqs. 5, 10, 12) as the scheme
-//! holds it between its assembly and its solve, and the mapping of the scene's
-//! `scheme.isph.ppe` options onto the linear solver ([`crate::linalg`]).
+//! The pressure Poisson system of a projection scheme (ISPH: Qiu 2013 eqs. 5, 10, 12; MPS:
+//! Lan 2022 eq. 4) as the scheme holds it between its assembly and its solve, and the
+//! mapping of the scene's `ppe` options onto the linear solver ([`crate::linalg`]).
 
 use crate::error::Cause;
 use crate::linalg::{CsrMatrix, Method, PreconditionerKind, SolveError, SolverParams};
@@ -11,7 +11,8 @@ use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
 pub struct PpeSystem {
     /// Matrix over the rows of non-free-surface particles.
     pub matrix: CsrMatrix,
-    /// Right-hand side `−div u* / Δt` \[Pa/m² per kg/m³\].
+    /// Right-hand side: ISPH `−div u* / Δt` \[Pa/m² per kg/m³\], MPS the negated mixed
+    /// source of Lan eq. 4 \[Pa/m²\].
     pub rhs: Vec<f64>,
     /// (diagonal, right-hand side) of each row as the assembly's pair pass leaves them.
     pub row_out: Vec<[f64; 2]>,

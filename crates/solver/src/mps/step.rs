@@ -1,0 +1,441 @@
+//! The stages of the semi-implicit MPS step (MPS.md "Step"; Koshizuka & Oka 1996 with Lan
+//! 2022's operators and PPE): neighbour lists, predictor, number density and free surface,
+//! PPE assembly and solve, velocity and position correction.
+
+use super::MpsData;
+use super::operators::Operators;
+use super::walls::Mirror;
+use super::weight::Weight;
+use crate::error::Cause;
+use crate::fields::Matrix;
+use crate::linalg::{LinearSolver, par_csr_rows_mut, stored};
+use crate::neighbours::CellSearch;
+use crate::scene::{MpsDivergence, MpsGradient};
+use crate::stage::{Stage, StepContext};
+use crate::state::{State, Vector};
+use rayon::prelude::*;
+
+/// The neighbour lists of every particle (fluid and wall) within the operators' largest
+/// radius plus a skin, so that one list serves the whole step: built at rⁿ (where the
+/// viscous term is evaluated), and at the provisional positions r* only if some particle
+/// moved farther than half the skin since (then a pair could have come within reach
+/// unseen). The operators compute each distance from the positions they read; a pair
+/// beyond an operator's radius weighs zero.
+#[derive(Debug)]
+pub struct Lists<const D: usize> {
+    search: CellSearch<D>,
+    skin: f64,
+    provisional: bool,
+}
+
+impl<const D: usize> Lists<D> {
+    /// The lists at the start of the step (also saves rⁿ and uⁿ), of radius
+    /// `reach + skin` \[m\].
+    pub fn start(reach: f64, skin: f64, domain: crate::neighbours::Domain<D>) -> Self {
+        Self { search: CellSearch::new(reach + skin, domain), skin, provisional: false }
+    }
+
+    /// The check (and, when needed, rebuild) at the provisional positions.
+    pub fn provisional(reach: f64, skin: f64, domain: crate::neighbours::Domain<D>) -> Self {
+        Self { provisional: true, ..Self::start(reach, skin, domain) }
+    }
+}
+
+impl<const D: usize, O> Stage<D, O> for Lists<D> {
+    fn name(&self) -> &'static str {
+        if self.provisional { "neighbours_provisional" } else { "neighbours" }
+    }
+
+    fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
+        let p = &mut s.particles;
+        if self.provisional {
+            let (x, x_old, dom) = (&p.x, &p.x_old, s.domain);
+            let moved = (0..p.fluid)
+                .into_par_iter()
+                .with_min_len(1024)
+                .map(|a| dom.displacement(&x[a], &x_old[a]).norm_squared())
+                .reduce(|| 0.0, f64::max);
+            if moved.sqrt() <= 0.5 * self.skin {
+                return Ok(());
+            }
+        } else {
+            p.x_old.clone_from(&p.x);
+            p.u_old.clone_from(&p.u);
+        }
+        self.search.build_rows(&p.x, p.total(), &mut s.neighbours);
+        Ok(())
+    }
+}
+
+/// MPS.md step 1: `u* = uⁿ + Δt (ν⟨∇²u⟩ⁿ + g)` with the Laplacian over the fluid and its
+/// no-slip wall images (Lan eq. 8, Fig. 2), then `r* = rⁿ + Δt u*`.
+#[derive(Debug)]
+pub struct Predictor<W: Weight, const D: usize> {
+    /// The operators.
+    pub ops: Operators<W, D>,
+    /// Kinematic viscosity ν \[m²/s\].
+    pub nu: f64,
+    /// Body force per unit mass \[m/s²\].
+    pub g: Vector<D>,
+    /// The walls' no-slip images.
+    pub mirror: Mirror,
+}
+
+impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Predictor<W, D> {
+    fn name(&self) -> &'static str {
+        "predictor"
+    }
+
+    fn run(&mut self, s: &mut State<D>, _own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
+        let (dt, nf, dom) = (ctx.dt, s.particles.fluid, s.domain);
+        let (ops, nu, g, mirror) = (&self.ops, self.nu, self.g, &self.mirror);
+        let periodic = dom.is_periodic();
+        let list = &s.neighbours;
+        let part = &mut s.particles;
+        let (x_old, u_old, u, x) = (&part.x_old, &part.u_old, &mut part.u, &mut part.x);
+        u[..nf].par_iter_mut().zip(x[..nf].par_iter_mut()).enumerate().with_min_len(256).for_each(
+            |(i, (u, x))| {
+                let mut a = g;
+                if nu > 0.0 {
+                    let (x_i, u_i) = (&x_old[i], u_old[i]);
+                    // The images of j (velocity −u_j) across the walls near i.
+                    let image = |x_j: &Vector<D>, u_j: Vector<D>, r_ij: &Vector<D>| {
+                        let mut sum = Vector::<D>::zeros();
+                        mirror.images(x_i, x_j, r_ij, ops.re_l, |r2| {
+                            sum -= (u_j + u_i) * ops.laplacian_weight(r2.sqrt());
+                        });
+                        sum
+                    };
+                    let mut lap = image(x_i, u_i, &Vector::zeros());
+                    for &j in list.of(i) {
+                        let j = j as usize;
+                        if j >= nf {
+                            continue;
+                        }
+                        let r_ij = dom.displacement(&x_old[j], x_i);
+                        lap += (u_old[j] - u_i) * ops.laplacian_weight(r_ij.norm());
+                        if !mirror.is_empty() {
+                            lap += image(&x_old[j], u_old[j], &r_ij);
+                        }
+                    }
+                    a += lap * nu;
+                }
+                *u = u_old[i] + a * dt;
+                *x = x_old[i] + *u * dt;
+                if periodic {
+                    dom.wrap(x);
+                }
+            },
+        );
+        Ok(())
+    }
+}
+
+/// MPS.md steps 2–3: the number density `n*` at r* (Lan eq. 9) of the fluid and the type-1
+/// wall particles, and their free-surface flags: `n* < β n0`, or with the auxiliary
+/// criterion `n* < 0.8 n0`, or `n* ≤ β n0` and `|F| > 0.9 |F|0`.
+#[derive(Debug)]
+pub struct NumberDensity<W: Weight, const D: usize> {
+    /// The operators.
+    pub ops: Operators<W, D>,
+    /// β of the test.
+    pub beta: f64,
+    /// Use the auxiliary criterion.
+    pub auxiliary: bool,
+}
+
+impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for NumberDensity<W, D> {
+    fn name(&self) -> &'static str {
+        "number_density"
+    }
+
+    fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, _ctx: &StepContext) -> Result<(), Cause> {
+        let rows = s.particles.fluid + own.type1;
+        let (x, list, dom, ops) = (&s.particles.x, &s.neighbours, s.domain, &self.ops);
+        let n0 = ops.number_density.n0;
+        let (beta, auxiliary) = (self.beta, self.auxiliary);
+        let f0 = ops.number_density.surface_f;
+        own.n_star.resize(rows, 0.0);
+        own.surface.resize(rows, false);
+        own.n_star.par_iter_mut().zip(own.surface.par_iter_mut()).enumerate().with_min_len(256).for_each(
+            |(i, (n, surface))| {
+                let (mut sum, mut f) = (0.0, Vector::<D>::zeros());
+                for &j in list.of(i) {
+                    let r_ij = dom.displacement(&x[j as usize], &x[i]);
+                    let r = r_ij.norm();
+                    let w = ops.density_weight(r);
+                    sum += w;
+                    if auxiliary && w > 0.0 {
+                        f -= r_ij * (w / r);
+                    }
+                }
+                *n = sum;
+                *surface = if auxiliary {
+                    let f = f.norm() * D as f64 / n0;
+                    sum < 0.8 * n0 || (sum <= beta * n0 && f > 0.9 * f0)
+                } else {
+                    sum < beta * n0
+                };
+            },
+        );
+        let nf = s.particles.fluid;
+        s.particles.free_surface.resize(nf, false);
+        s.particles.free_surface.copy_from_slice(&own.surface[..nf]);
+        Ok(())
+    }
+}
+
+/// MPS.md step 3, Lan eq. 4 with Lee et al.'s mixed source, as `A P = b` with `A` symmetric
+/// positive definite: for every fluid and type-1 wall particle off the free surface,
+/// `Σ_j a_ij (P_i − P_j) + (ρ α/Δt²) P_i = −(1 − γ)(ρ/Δt)⟨∇·u*⟩_i + γ (ρ/Δt²)(n*_i − n0)/n0`,
+/// `a_ij = (2d/(λ n0)) w_ij`. Free-surface particles (P = 0) drop out; type-2 wall
+/// particles enter with their last extrapolated pressure, moved to the right-hand side.
+#[derive(Debug)]
+pub struct PpeAssemble<W: Weight, const D: usize> {
+    /// The operators.
+    pub ops: Operators<W, D>,
+    /// γ of the mixed source.
+    pub gamma: f64,
+    /// Quasi-compressibility α \[1/Pa\].
+    pub compressibility: f64,
+    /// Form of the velocity divergence of the source.
+    pub divergence: MpsDivergence,
+}
+
+impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
+    fn name(&self) -> &'static str {
+        "ppe_assemble"
+    }
+
+    fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
+        let nf = s.particles.fluid;
+        let solved = nf + own.type1;
+        let total = s.particles.total();
+        let sys = &mut own.ppe;
+        sys.row_of.clear();
+        sys.row_of.resize(total, u32::MAX);
+        sys.particle_of.clear();
+        for (i, &surface) in own.surface[..solved].iter().enumerate() {
+            if !surface {
+                sys.row_of[i] = sys.particle_of.len() as u32;
+                sys.particle_of.push(i as u32);
+            }
+        }
+        let rows = sys.particle_of.len();
+        // Known pressures: the free surface (zero) and the type-2 walls.
+        sys.singular = rows == solved && total == solved;
+        let (x, u, p, list, dom, ops) =
+            (&s.particles.x, &s.particles.u, &s.particles.p, &s.neighbours, s.domain, &self.ops);
+        let (row_of, particle_of, n_star) = (&sys.row_of, &sys.particle_of, &own.n_star);
+        let m = &mut sys.matrix;
+        m.row_ptr.resize(rows + 1, 0);
+        m.row_ptr[0] = 0;
+        m.row_ptr[1..].par_iter_mut().enumerate().with_min_len(256).for_each(|(k, len)| {
+            let i = particle_of[k] as usize;
+            *len = list
+                .of(i)
+                .iter()
+                .filter(|&&j| {
+                    let rj = row_of[j as usize];
+                    rj != u32::MAX
+                        && rj != k as u32
+                        && dom.displacement(&x[j as usize], &x[i]).norm() < ops.re_l
+                })
+                .count();
+        });
+        for k in 0..rows {
+            m.row_ptr[k + 1] += m.row_ptr[k];
+        }
+        m.resize_entries();
+        let (rho, dt) = (s.density, ctx.dt);
+        let (gamma, n0) = (self.gamma, ops.number_density.n0);
+        let corrected = self.divergence == MpsDivergence::Corrected;
+        let compress = rho * self.compressibility / (dt * dt);
+        sys.row_out.resize(rows, [0.0; 2]);
+        let row = |k: usize, cols: &mut [u32], vals: &mut [f32], out: &mut [f64; 2]| {
+            let i = particle_of[k] as usize;
+            let (mut diag, mut known) = (compress, 0.0);
+            // Σ (u_j − u_i) ⊗ r_ij w/r² (its trace times d/n0 is Lan's divergence) and the moment.
+            let (mut grad_u, mut moment) = (Matrix::<D>::zeros(), Matrix::<D>::zeros());
+            let mut e = 0;
+            for &j in list.of(i) {
+                let j = j as usize;
+                let r_ij = dom.displacement(&x[j], &x[i]);
+                let r = r_ij.norm();
+                let wg = ops.gradient_weight(r);
+                if wg > 0.0 {
+                    grad_u += (u[j] - u[i]) * r_ij.transpose() * wg;
+                    if corrected {
+                        moment += r_ij * r_ij.transpose() * wg;
+                    }
+                }
+                if r >= ops.re_l {
+                    continue;
+                }
+                // Rounded as stored, here and in the diagonal (see `CsrMatrix`).
+                let c = stored(ops.laplacian_weight(r));
+                diag += c;
+                match row_of[j] {
+                    // Free-surface particles hold P = 0; type-2 walls their extrapolation.
+                    u32::MAX if j < solved => {}
+                    u32::MAX => known += c * p[j],
+                    rj => {
+                        (cols[e], vals[e]) = (rj, -c as f32);
+                        e += 1;
+                    }
+                }
+            }
+            let div = if corrected
+                && let Some(chol) = moment.cholesky()
+                && chol.determinant() > MOMENT_DET_MIN
+            {
+                (grad_u * chol.inverse()).trace()
+            } else {
+                grad_u.trace()
+            };
+            let source = (1.0 - gamma) * rho / dt * div - gamma * rho / (dt * dt) * (n_star[i] - n0) / n0;
+            *out = [diag, -source + known];
+        };
+        par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut sys.row_out, &row);
+        m.diag.resize(rows, 0.0);
+        m.inv_diag.resize(rows, 0.0);
+        sys.rhs.resize(rows, 0.0);
+        m.diag
+            .par_iter_mut()
+            .zip(m.inv_diag.par_iter_mut())
+            .zip(sys.rhs.par_iter_mut())
+            .zip(sys.row_out.par_iter())
+            .with_min_len(512)
+            .for_each(|(((d, inv), r), out)| {
+                (*d, *inv, *r) = (out[0], 1.0 / out[0], out[1]);
+            });
+        Ok(())
+    }
+}
+
+/// Solves the assembled PPE, warm-started from the last pressures; writes P (zero on the
+/// free surface), and clips negative pressures when asked (Koshizuka's sample code).
+#[derive(Debug)]
+pub struct PpeSolve {
+    /// The configured solver.
+    pub solver: LinearSolver,
+    /// Set negative pressures to zero after the solve.
+    pub clip_negative: bool,
+}
+
+impl<const D: usize> Stage<D, MpsData<D>> for PpeSolve {
+    fn name(&self) -> &'static str {
+        "ppe_solve"
+    }
+
+    fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, _ctx: &StepContext) -> Result<(), Cause> {
+        let nf = s.particles.fluid;
+        let sys = &mut own.ppe;
+        let p = &mut s.particles.p;
+        sys.solution.clear();
+        sys.solution.extend(sys.particle_of.iter().map(|&i| p[i as usize]));
+        // Fluid rows are keyed by particle id, wall rows after every fluid id.
+        let keys = if self.solver.uses_row_keys() {
+            let (id, base) = (&s.particles.id, own.key_base);
+            sys.row_key.clear();
+            sys.row_key.extend(sys.particle_of.iter().map(|&i| {
+                let i = i as usize;
+                if i < nf { id[i] } else { base + (i - nf) as u32 }
+            }));
+            Some(&sys.row_key[..])
+        } else {
+            None
+        };
+        s.solve = self
+            .solver
+            .solve_keyed(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular, keys)
+            .map_err(crate::ppe::cause)?;
+        let solved = nf + own.type1;
+        p[..solved].iter_mut().for_each(|v| *v = 0.0);
+        for (v, &i) in sys.solution.iter().zip(&sys.particle_of) {
+            p[i as usize] = if self.clip_negative { v.max(0.0) } else { *v };
+        }
+        Ok(())
+    }
+}
+
+/// MPS.md step 4: `uⁿ⁺¹ = u* − (Δt/ρ)⟨∇P⟩` at r* over the fluid and wall particles, with
+/// Lan's eq. 6, Koshizuka's minimum-pressure form or the corrective matrix; then
+/// `rⁿ⁺¹ = r* + Δt (uⁿ⁺¹ − u*)`.
+#[derive(Debug)]
+pub struct Correction<W: Weight, const D: usize> {
+    /// The operators.
+    pub ops: Operators<W, D>,
+    /// Form of the gradient.
+    pub form: MpsGradient,
+}
+
+/// Below this determinant of the moment `(d/n0) Σ w r⊗r/|r|²` (1 on the full lattice, about
+/// 0.3 at a flat surface in 2D) the corrected gradient falls back to the plain one.
+const MOMENT_DET_MIN: f64 = 1e-2;
+
+impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Correction<W, D> {
+    fn name(&self) -> &'static str {
+        "correction"
+    }
+
+    fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
+        let (dt, nf, dom) = (ctx.dt, s.particles.fluid, s.domain);
+        let periodic = dom.is_periodic();
+        let (list, p, x, ops, form) = (&s.neighbours, &s.particles.p, &s.particles.x, &self.ops, self.form);
+        let c = dt / s.density;
+        // The velocity change of each particle first (the positions are read as neighbours).
+        own.du.resize(nf, Vector::zeros());
+        own.du.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, du)| {
+            let x_i = &x[i];
+            let base = match form {
+                MpsGradient::Minimum => list.of(i).iter().fold(p[i], |m, &j| {
+                    let j = j as usize;
+                    if dom.displacement(&x[j], x_i).norm() < ops.re_g { m.min(p[j]) } else { m }
+                }),
+                MpsGradient::Lan | MpsGradient::Corrected => p[i],
+            };
+            let corrected = form == MpsGradient::Corrected;
+            let (mut g, mut m, mut count) = (Vector::<D>::zeros(), Matrix::<D>::zeros(), 0);
+            for &j in list.of(i) {
+                let j = j as usize;
+                let r_ij = dom.displacement(&x[j], x_i);
+                let wg = ops.gradient_weight(r_ij.norm());
+                if wg == 0.0 {
+                    continue;
+                }
+                g += r_ij * ((p[j] - base) * wg);
+                if corrected {
+                    m += r_ij * r_ij.transpose() * wg;
+                    count += 1;
+                }
+            }
+            // The moment is symmetric: positive definite unless degenerate, its determinant
+            // the square of the Cholesky factor's diagonal product.
+            if corrected
+                && count >= 4
+                && let Some(chol) = m.cholesky()
+                && chol.determinant() > MOMENT_DET_MIN
+            {
+                g = chol.solve(&g);
+            }
+            *du = -g * c;
+        });
+        // rⁿ⁺¹ = r* + Δt (uⁿ⁺¹ − u*).
+        let parts = &mut s.particles;
+        let du = &own.du;
+        parts.u[..nf]
+            .par_iter_mut()
+            .zip(parts.x[..nf].par_iter_mut())
+            .zip(du.par_iter())
+            .with_min_len(512)
+            .for_each(|((u, x), du)| {
+                *u += du;
+                *x += du * dt;
+                if periodic {
+                    dom.wrap(x);
+                }
+            });
+        Ok(())
+    }
+}
