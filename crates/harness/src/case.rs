@@ -571,7 +571,7 @@ mod tests {
         assert_eq!(case.spacings(Tier::Quick), [0.04, 0.02]);
         assert_eq!(case.spacings(Tier::Full).len(), 4);
         assert_eq!(case.primary_preset(), "paper");
-        assert_eq!(case.presets(Tier::Quick).count(), 4);
+        assert_eq!(case.presets(Tier::Quick).count(), 6);
         assert!(case.checks.len() >= 8);
         assert!(!case.errata.is_empty());
     }
@@ -607,7 +607,7 @@ mod tests {
         for (edit, says) in [
             (serde_json::json!({"select": {"preset": "paperr"}}), "`select.preset` = \"paperr\""),
             (serde_json::json!({"select": {"dx": 0.03}}), "`select.dx` = 0.03"),
-            (serde_json::json!({"select": {"scheme": "mps"}}), "`select.scheme` = \"mps\""),
+            (serde_json::json!({"select": {"scheme": "otm"}}), "`select.scheme` = \"otm\""),
             (serde_json::json!({"select": {"dx": 0.005}, "tiers": ["quick"]}), "tier `quick`"),
         ] {
             let e = error(&|c| crate::patch::merge_patch(c, &edit)).unwrap_or_default();

@@ -188,13 +188,17 @@ mod tests {
                 "isph-tuned_dx0.04",
                 "wcsph-wcsph_paper_dx0.04",
                 "wcsph-wcsph_tuned_dx0.04",
+                "mps-mps_paper_dx0.04",
+                "mps-mps_dx0.04",
                 "isph-paper_dx0.02",
                 "isph-tuned_dx0.02",
                 "wcsph-wcsph_paper_dx0.02",
-                "wcsph-wcsph_tuned_dx0.02"
+                "wcsph-wcsph_tuned_dx0.02",
+                "mps-mps_paper_dx0.02",
+                "mps-mps_dx0.02"
             ]
         );
-        assert!((runs[4].scene.dx - 0.02).abs() < 1e-15);
+        assert!((runs[6].scene.dx - 0.02).abs() < 1e-15);
         // The tuned preset's merge patch replaces Xu shifting by Fickian shifting.
         assert_eq!(runs[1].scene_json["scheme"]["isph"]["divergence"], "corrected");
         assert!(runs[1].scene_json["scheme"]["isph"]["shifting"].get("xu").is_none());
@@ -206,14 +210,16 @@ mod tests {
         assert!(runs[2].scene_json["time"]["step"].get("adaptive").is_some());
         assert_eq!(runs[0].hash.len(), 64);
         assert_ne!(runs[0].hash, runs[1].hash);
-        assert_ne!(runs[0].hash, runs[4].hash);
+        assert_ne!(runs[0].hash, runs[6].hash);
+        // The MPS presets replace the scheme too.
+        assert_eq!(runs[5].scene_json["scheme"]["mps"]["gamma"], 0.01);
         let full = expand(&committed("elliptical_drop"), Tier::Full).unwrap();
-        assert_eq!(full.len(), 16);
+        assert_eq!(full.len(), 24);
         // Δt scales with dx below the template's 0.02 (CFL number kept), not above it.
         let dt = |r: &RunSpec| r.scene_json["time"]["step"]["fixed"].as_f64().unwrap();
         assert!((dt(&full[0]) - 2e-5).abs() < 1e-18, "dx = 0.04 keeps the paper's dt");
-        assert!((dt(&full[4]) - 2e-5).abs() < 1e-18);
-        assert!((dt(&full[12]) - 5e-6).abs() < 1e-18, "dx = 0.005: {}", dt(&full[12]));
+        assert!((dt(&full[6]) - 2e-5).abs() < 1e-18);
+        assert!((dt(&full[18]) - 5e-6).abs() < 1e-18, "dx = 0.005: {}", dt(&full[18]));
     }
 
     #[test]
@@ -226,15 +232,15 @@ mod tests {
         let runs = expand(&c, Tier::Quick).unwrap();
         let slugs: Vec<&str> = runs.iter().map(|r| r.slug.as_str()).collect();
         assert_eq!(
-            slugs[4..7],
+            slugs[6..9],
             ["isph-paper_dx0.02", "isph-paper_dx0.02_start1", "isph-paper_dx0.02_start2"]
         );
-        assert_eq!(runs.len(), 10, "two more runs at 0.02, none at 0.04");
-        assert_eq!((runs[5].start, runs[6].start), (Some(1), Some(2)));
-        let jitter = &runs[6].scene_json["bodies"][0]["jitter"];
+        assert_eq!(runs.len(), 14, "two more runs at 0.02, none at 0.04");
+        assert_eq!((runs[7].start, runs[8].start), (Some(1), Some(2)));
+        let jitter = &runs[8].scene_json["bodies"][0]["jitter"];
         assert_eq!((jitter["fraction"].as_f64(), jitter["seed"].as_u64()), (Some(1e-12), Some(2)));
-        assert!(runs[4].scene_json["bodies"][0].get("jitter").is_none_or(|j| j.is_null()));
-        assert!(runs[4].hash != runs[5].hash && runs[5].hash != runs[6].hash);
+        assert!(runs[6].scene_json["bodies"][0].get("jitter").is_none_or(|j| j.is_null()));
+        assert!(runs[6].hash != runs[7].hash && runs[7].hash != runs[8].hash);
         // Malformed ensembles are rejected when the case loads, naming the field.
         for (bad, field) in [
             (serde_json::json!({"dx": [0.03], "seeds": [1], "reason": "r"}), "perturbed_starts.dx"),

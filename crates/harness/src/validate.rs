@@ -260,7 +260,12 @@ pub fn run_result(case: &Case, spec: &RunSpec, ran: &Ran) -> Result<RunResult> {
 /// Builds a case's results from its runs: orders and checks.
 pub fn assemble(case: &Case, tier: Tier, runs: Vec<RunResult>) -> CaseResults {
     let convergence = convergence(case, &runs);
-    let mut checks = evaluate_all(&case.checks, &runs, tier);
+    // A run that diverged where its preset expects it to is judged once, by its completion
+    // check below; the other checks read the runs that completed or were not expected to
+    // stop (an expected divergence that completed is an unexpected pass, judged by all).
+    let judged: Vec<RunResult> =
+        runs.iter().filter(|r| r.ok() || expected_divergence(case, r).is_none()).cloned().collect();
+    let mut checks = evaluate_all(&case.checks, &judged, tier);
     if checks.is_empty() {
         // A case that nothing judges cannot fail: it reads as a failure, not "0 / 0".
         checks.push(crate::results::CheckResult {
@@ -283,14 +288,17 @@ pub fn assemble(case: &Case, tier: Tier, runs: Vec<RunResult>) -> CaseResults {
     }
 }
 
+/// The reason a run's preset expects it to diverge at its spacing, if it does.
+fn expected_divergence<'a>(case: &'a Case, r: &RunResult) -> Option<&'a str> {
+    case.sweep.presets.iter().find(|p| p.name == r.preset).and_then(|p| p.expected_divergence_at(r.dx))
+}
+
 /// Every run reaches its end time: one check for the runs no preset expects to diverge
 /// (failing with the slugs of those that did not), and one strict expected failure per run
 /// that its preset expects to diverge (`expected_divergence`, with its reason): its
 /// completion is an unexpected pass.
 fn completion_checks(case: &Case, runs: &[RunResult]) -> Vec<crate::results::CheckResult> {
-    let expected = |r: &RunResult| {
-        case.sweep.presets.iter().find(|p| p.name == r.preset).and_then(|p| p.expected_divergence_at(r.dx))
-    };
+    let expected = |r: &RunResult| expected_divergence(case, r);
     let mut out = Vec::new();
     let unmarked: Vec<&RunResult> = runs.iter().filter(|r| expected(r).is_none()).collect();
     if !unmarked.is_empty() {
@@ -497,7 +505,8 @@ mod tests {
     }
 
     /// Every run reaches its end time unless its preset expects it to diverge there: then
-    /// its divergence is an expected failure and its completion an unexpected pass.
+    /// its divergence is an expected failure (and no other check reads the run) and its
+    /// completion an unexpected pass.
     #[test]
     fn runs_must_complete_unless_expected_to_diverge() {
         use crate::case::ExpectedDivergence;
@@ -522,6 +531,14 @@ mod tests {
         let c = completion(&case, vec![synthetic("paper", 0.04, 5.0, 1976), diverged(0.02, 7860)]);
         let verdicts: Vec<Verdict> = c.iter().map(|c| c.verdict()).collect();
         assert_eq!(verdicts, [Verdict::Pass, Verdict::ExpectedFail], "{c:?}");
+        // Judged once: no other check reads the run that diverged as expected.
+        let runs = results(vec![synthetic("paper", 0.04, 5.0, 1976), diverged(0.02, 7860)]).runs;
+        let others = assemble(&case, Tier::Quick, runs).checks;
+        let reads_it = |c: &crate::results::CheckResult| c.note.as_deref().unwrap_or("").contains("diverged");
+        assert!(
+            !others.iter().any(|c| !c.name.contains("reaches its end time") && reads_it(c)),
+            "{others:?}"
+        );
         let c =
             completion(&case, vec![synthetic("paper", 0.04, 5.0, 1976), synthetic("paper", 0.02, 5.0, 7860)]);
         assert_eq!(c[1].verdict(), Verdict::UnexpectedPass);

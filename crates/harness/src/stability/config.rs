@@ -87,7 +87,7 @@ pub struct BaseCase {
 pub struct OptionSet {
     /// Name (a row's `preset`, part of the slugs).
     pub name: String,
-    /// The scheme its scenes run (`isph` or `wcsph`; a row's `scheme`).
+    /// The scheme its scenes run (`isph`, `wcsph` or `mps`; a row's `scheme`).
     pub scheme: String,
     /// What it is, for the page.
     pub description: String,
@@ -220,11 +220,11 @@ impl Config {
             if !names.insert(o.name.as_str()) {
                 return Err(bad(&field("name"), format!("{:?}", o.name), "is defined twice"));
             }
-            if o.scheme != "isph" && o.scheme != "wcsph" {
+            if !["isph", "wcsph", "mps"].contains(&o.scheme.as_str()) {
                 return Err(bad(
                     &field("scheme"),
                     format!("{:?}", o.scheme),
-                    "must be \"isph\" or \"wcsph\"",
+                    "must be \"isph\", \"wcsph\" or \"mps\"",
                 ));
             }
             for (case, c) in &o.cases {
@@ -282,12 +282,15 @@ mod tests {
     #[test]
     fn the_committed_file_is_the_published_budget() {
         let c = Config::from_json(&committed().to_string(), Path::new("s.json")).unwrap();
-        assert_eq!(c.settings.option_sets, ["xu", "none", "xu_difference", "fickian", "wcsph", "wcsph_xu"]);
+        assert_eq!(
+            c.settings.option_sets,
+            ["xu", "none", "xu_difference", "fickian", "wcsph", "wcsph_xu", "mps_paper", "mps"]
+        );
         assert_eq!(c.settings.channel_dx.to_bits(), (0.2f64 / 18.0).to_bits(), "D/18 to the last bit");
         assert_eq!((c.settings.dt_range, c.settings.re_range), ([0.25, 5.0], [4.0, 4000.0]));
-        assert_eq!(c.checks.len(), 12);
+        assert_eq!(c.checks.len(), 15);
         assert!(
-            matches!(c.checks[0], Check::Explained { .. }) && matches!(c.checks[11], Check::Jittered { .. })
+            matches!(c.checks[0], Check::Explained { .. }) && matches!(c.checks[14], Check::Jittered { .. })
         );
     }
 
@@ -308,9 +311,9 @@ mod tests {
             "{e}"
         );
         let mut v = committed();
-        v["option_sets"][4]["scheme"] = "mps".into();
+        v["option_sets"][4]["scheme"] = "otm".into();
         let e = error(&v);
-        assert!(e.contains("option_sets[4].scheme") && e.contains("mps"), "{e}");
+        assert!(e.contains("option_sets[4].scheme") && e.contains("otm"), "{e}");
         let mut v = committed();
         v["checks"][1]["bound"]["min"] = Value::Null;
         let e = error(&v);

@@ -1,10 +1,10 @@
 //! Moving particle semi-implicit (MPS; Koshizuka & Oka 1996) with the operators of Lan,
 //! Zhao & Wan 2022 (eqs. 3–9) and Lee et al.'s mixed PPE source (Lan eq. 4): MPS.md.
 //!
-//! The step, built from the scene: `reorder` (locality) → `neighbours` (lists of every
+//! The step, built from the scene: `reorder` (locality) → `neighbour_lists` (lists of every
 //! particle within the largest operator radius plus a skin, at rⁿ; saves rⁿ, uⁿ) →
 //! `predictor` (`u* = uⁿ + Δt(ν⟨∇²u⟩ + g)` with no-slip wall images, `r* = rⁿ + Δt u*`) →
-//! `neighbours_provisional` (rebuilt only if a particle moved more than half the skin) →
+//! `neighbour_lists_provisional` (rebuilt only if a particle moved more than half the skin) →
 //! `number_density` (n* at r*, free-surface flags) → `ppe_assemble` → `ppe_solve` (CG or
 //! BiCGSTAB, Jacobi or two-level) → `wall_pressure` (type-2 walls extrapolated; with walls
 //! only) → `correction` (`uⁿ⁺¹ = u* − (Δt/ρ)⟨∇P⟩`, `rⁿ⁺¹ = r* + Δt(uⁿ⁺¹ − u*)`) → with
@@ -67,14 +67,21 @@ pub struct MpsData<const D: usize> {
     /// Key of the first wall particle's PPE row for the two-level preconditioner (after
     /// every fluid id).
     pub key_base: u32,
-    /// Number density n* at r* of the fluid and the type-1 walls.
-    pub n_star: Vec<f64>,
-    /// Free-surface flags of the fluid and the type-1 walls.
-    pub surface: Vec<bool>,
+    /// Number density n* at r* and free-surface flag of every particle.
+    pub density: Vec<Density>,
     /// The pressure Poisson system of the step.
     pub ppe: crate::ppe::PpeSystem,
     /// The velocity change of the correction, per fluid particle \[m/s\].
     pub du: Vec<Vector<D>>,
+}
+
+/// A particle's number density at r* and its free-surface flag.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Density {
+    /// n* (dimensionless).
+    pub n: f64,
+    /// n* below the free-surface threshold: P = 0.
+    pub surface: bool,
 }
 
 /// No per-particle field to carry from step to step: every array is rebuilt each step

@@ -2,17 +2,18 @@
 //! 2022's operators and PPE): neighbour lists, predictor, number density and free surface,
 //! PPE assembly and solve, velocity and position correction.
 
-use super::MpsData;
 use super::operators::Operators;
 use super::walls::Mirror;
 use super::weight::Weight;
+use super::{Density, MpsData};
 use crate::error::Cause;
 use crate::fields::Matrix;
 use crate::linalg::{LinearSolver, par_csr_rows_mut, stored};
 use crate::neighbours::CellSearch;
 use crate::scene::{MpsDivergence, MpsGradient};
+use crate::stage::par_rows_mut;
 use crate::stage::{Stage, StepContext};
-use crate::state::{State, Vector};
+use crate::state::{Pair, State, Vector};
 use rayon::prelude::*;
 
 /// The neighbour lists of every particle (fluid and wall) within the operators' largest
@@ -43,7 +44,7 @@ impl<const D: usize> Lists<D> {
 
 impl<const D: usize, O> Stage<D, O> for Lists<D> {
     fn name(&self) -> &'static str {
-        if self.provisional { "neighbours_provisional" } else { "neighbours" }
+        if self.provisional { "neighbour_lists_provisional" } else { "neighbour_lists" }
     }
 
     fn run(&mut self, s: &mut State<D>, _own: &mut O, _ctx: &StepContext) -> Result<(), Cause> {
@@ -131,9 +132,10 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Predictor<W, D> {
     }
 }
 
-/// MPS.md steps 2–3: the number density `n*` at r* (Lan eq. 9) of the fluid and the type-1
-/// wall particles, and their free-surface flags: `n* < β n0`, or with the auxiliary
-/// criterion `n* < 0.8 n0`, or `n* ≤ β n0` and `|F| > 0.9 |F|0`.
+/// MPS.md steps 2–3: the number density `n*` at r* (Lan eq. 9) of every particle and the
+/// free-surface flags (read for the fluid and the type-1 walls): `n* < β n0`, or with the
+/// auxiliary criterion `n* < 0.8 n0`, or `n* ≤ β n0` and `|F| > 0.9 |F|0`. Fills the pair
+/// cache at r* that the PPE, the wall pressures and the correction read.
 #[derive(Debug)]
 pub struct NumberDensity<W: Weight, const D: usize> {
     /// The operators.
@@ -150,37 +152,42 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for NumberDensity<W, D> {
     }
 
     fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, _ctx: &StepContext) -> Result<(), Cause> {
-        let rows = s.particles.fluid + own.type1;
         let (x, list, dom, ops) = (&s.particles.x, &s.neighbours, s.domain, &self.ops);
         let n0 = ops.number_density.n0;
         let (beta, auxiliary) = (self.beta, self.auxiliary);
         let f0 = ops.number_density.surface_f;
-        own.n_star.resize(rows, 0.0);
-        own.surface.resize(rows, false);
-        own.n_star.par_iter_mut().zip(own.surface.par_iter_mut()).enumerate().with_min_len(256).for_each(
-            |(i, (n, surface))| {
+        s.pairs.resize(list.pairs(), Pair::default());
+        own.density.resize(s.particles.total(), Density::default());
+        // The pair cache at r* (`r_ab = r_a − r_b`, `f = |r_ab|`) for every later stage of
+        // the step, and each row's number density in the same pass.
+        par_rows_mut(
+            &list.offsets,
+            &mut s.pairs,
+            &mut own.density,
+            &|i, row: &mut [Pair<D>], out: &mut Density| {
                 let (mut sum, mut f) = (0.0, Vector::<D>::zeros());
-                for &j in list.of(i) {
-                    let r_ij = dom.displacement(&x[j as usize], &x[i]);
-                    let r = r_ij.norm();
+                for (pair, &j) in row.iter_mut().zip(list.of(i)) {
+                    let r_ab = dom.displacement(&x[i], &x[j as usize]);
+                    let r = r_ab.norm();
+                    *pair = Pair { r_ab, f: r };
                     let w = ops.density_weight(r);
                     sum += w;
                     if auxiliary && w > 0.0 {
-                        f -= r_ij * (w / r);
+                        f += r_ab * (w / r);
                     }
                 }
-                *n = sum;
-                *surface = if auxiliary {
+                let surface = if auxiliary {
                     let f = f.norm() * D as f64 / n0;
                     sum < 0.8 * n0 || (sum <= beta * n0 && f > 0.9 * f0)
                 } else {
                     sum < beta * n0
                 };
+                *out = Density { n: sum, surface };
             },
         );
         let nf = s.particles.fluid;
         s.particles.free_surface.resize(nf, false);
-        s.particles.free_surface.copy_from_slice(&own.surface[..nf]);
+        s.particles.free_surface.iter_mut().zip(&own.density).for_each(|(f, d)| *f = d.surface);
         Ok(())
     }
 }
@@ -215,8 +222,8 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
         sys.row_of.clear();
         sys.row_of.resize(total, u32::MAX);
         sys.particle_of.clear();
-        for (i, &surface) in own.surface[..solved].iter().enumerate() {
-            if !surface {
+        for (i, d) in own.density[..solved].iter().enumerate() {
+            if !d.surface {
                 sys.row_of[i] = sys.particle_of.len() as u32;
                 sys.particle_of.push(i as u32);
             }
@@ -224,22 +231,20 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
         let rows = sys.particle_of.len();
         // Known pressures: the free surface (zero) and the type-2 walls.
         sys.singular = rows == solved && total == solved;
-        let (x, u, p, list, dom, ops) =
-            (&s.particles.x, &s.particles.u, &s.particles.p, &s.neighbours, s.domain, &self.ops);
-        let (row_of, particle_of, n_star) = (&sys.row_of, &sys.particle_of, &own.n_star);
+        let (u, p, list, pairs, ops) = (&s.particles.u, &s.particles.p, &s.neighbours, &s.pairs, &self.ops);
+        let (row_of, particle_of, density) = (&sys.row_of, &sys.particle_of, &own.density);
         let m = &mut sys.matrix;
         m.row_ptr.resize(rows + 1, 0);
         m.row_ptr[0] = 0;
         m.row_ptr[1..].par_iter_mut().enumerate().with_min_len(256).for_each(|(k, len)| {
             let i = particle_of[k] as usize;
-            *len = list
-                .of(i)
+            let (lo, hi) = (list.offsets[i], list.offsets[i + 1]);
+            *len = list.indices[lo..hi]
                 .iter()
-                .filter(|&&j| {
+                .zip(&pairs[lo..hi])
+                .filter(|&(&j, pair)| {
                     let rj = row_of[j as usize];
-                    rj != u32::MAX
-                        && rj != k as u32
-                        && dom.displacement(&x[j as usize], &x[i]).norm() < ops.re_l
+                    rj != u32::MAX && rj != k as u32 && pair.f < ops.re_l
                 })
                 .count();
         });
@@ -258,10 +263,9 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
             // Σ (u_j − u_i) ⊗ r_ij w/r² (its trace times d/n0 is Lan's divergence) and the moment.
             let (mut grad_u, mut moment) = (Matrix::<D>::zeros(), Matrix::<D>::zeros());
             let mut e = 0;
-            for &j in list.of(i) {
-                let j = j as usize;
-                let r_ij = dom.displacement(&x[j], &x[i]);
-                let r = r_ij.norm();
+            let (lo, hi) = (list.offsets[i], list.offsets[i + 1]);
+            for (&j, pair) in list.indices[lo..hi].iter().zip(&pairs[lo..hi]) {
+                let (j, r_ij, r) = (j as usize, -pair.r_ab, pair.f);
                 let wg = ops.gradient_weight(r);
                 if wg > 0.0 {
                     grad_u += (u[j] - u[i]) * r_ij.transpose() * wg;
@@ -293,7 +297,7 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
             } else {
                 grad_u.trace()
             };
-            let source = (1.0 - gamma) * rho / dt * div - gamma * rho / (dt * dt) * (n_star[i] - n0) / n0;
+            let source = (1.0 - gamma) * rho / dt * div - gamma * rho / (dt * dt) * (density[i].n - n0) / n0;
             *out = [diag, -source + known];
         };
         par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut sys.row_out, &row);
@@ -382,25 +386,24 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Correction<W, D> {
     fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
         let (dt, nf, dom) = (ctx.dt, s.particles.fluid, s.domain);
         let periodic = dom.is_periodic();
-        let (list, p, x, ops, form) = (&s.neighbours, &s.particles.p, &s.particles.x, &self.ops, self.form);
+        let (list, pairs, p, ops, form) = (&s.neighbours, &s.pairs, &s.particles.p, &self.ops, self.form);
         let c = dt / s.density;
         // The velocity change of each particle first (the positions are read as neighbours).
         own.du.resize(nf, Vector::zeros());
         own.du.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, du)| {
-            let x_i = &x[i];
+            let (lo, hi) = (list.offsets[i], list.offsets[i + 1]);
+            let row = || list.indices[lo..hi].iter().zip(&pairs[lo..hi]);
             let base = match form {
-                MpsGradient::Minimum => list.of(i).iter().fold(p[i], |m, &j| {
-                    let j = j as usize;
-                    if dom.displacement(&x[j], x_i).norm() < ops.re_g { m.min(p[j]) } else { m }
-                }),
+                MpsGradient::Minimum => {
+                    row().fold(p[i], |m, (&j, pair)| if pair.f < ops.re_g { m.min(p[j as usize]) } else { m })
+                }
                 MpsGradient::Lan | MpsGradient::Corrected => p[i],
             };
             let corrected = form == MpsGradient::Corrected;
             let (mut g, mut m, mut count) = (Vector::<D>::zeros(), Matrix::<D>::zeros(), 0);
-            for &j in list.of(i) {
-                let j = j as usize;
-                let r_ij = dom.displacement(&x[j], x_i);
-                let wg = ops.gradient_weight(r_ij.norm());
+            for (&j, pair) in row() {
+                let (j, r_ij) = (j as usize, -pair.r_ab);
+                let wg = ops.gradient_weight(pair.f);
                 if wg == 0.0 {
                     continue;
                 }

@@ -108,21 +108,21 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for WallPressure<W, D> {
 
     fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, _ctx: &StepContext) -> Result<(), Cause> {
         let start = s.particles.fluid + own.type1;
-        let (x, list, dom, rho, g, ops) =
-            (&s.particles.x, &s.neighbours, s.domain, s.density, self.g, &self.ops);
+        let (list, pairs, rho, g, ops) = (&s.neighbours, &s.pairs, s.density, self.g, &self.ops);
         let (p_all, type2) = s.particles.p.split_at_mut(start);
         let p_solved = &*p_all;
         type2.par_iter_mut().enumerate().with_min_len(256).for_each(|(k, pk)| {
             let a = start + k;
             let (mut sum, mut wsum) = (0.0, 0.0);
-            for &b in list.of(a) {
+            let (lo, hi) = (list.offsets[a], list.offsets[a + 1]);
+            for (&b, pair) in list.indices[lo..hi].iter().zip(&pairs[lo..hi]) {
                 let b = b as usize;
                 if b >= start {
                     continue;
                 }
-                // r_k − r_j.
-                let r_kj = dom.displacement(&x[a], &x[b]);
-                let w = ops.density_weight(r_kj.norm());
+                // r_k − r_j (the pair cache of this step's positions).
+                let r_kj = pair.r_ab;
+                let w = ops.density_weight(pair.f);
                 sum += w * (p_solved[b] + rho * g.dot(&r_kj));
                 wsum += w;
             }
