@@ -15,7 +15,9 @@
 //! runs its `select` matches in the tier being run; a check matching no run (a spacing of
 //! another tier) is not applicable and is left out. A matching run that diverged, or a
 //! metric that is missing or not finite, fails the check (with a `note` saying why; the
-//! check's `missing` replaces the note of a missing metric).
+//! check's `missing` replaces the note of a missing metric). A run that diverged where its
+//! preset expects it to is not handed to the checks at all: its own completion check
+//! (`validate`) judges it.
 //!
 //! A preset's perturbed starts (`sweep.presets[].perturbed_starts`) are more runs at the
 //! same spacing: a bound judges every member (the worst is the value, the note gives the
