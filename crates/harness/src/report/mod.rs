@@ -330,7 +330,11 @@ mod tests {
             assert!(text.starts_with("<svg") && text.contains("</svg>"), "{svg}");
         }
         let conv = std::fs::read_to_string(out.join("elliptical_drop/convergence.svg")).unwrap();
-        assert!(conv.contains("b_rel_err_max (paper): order 2.00"), "legend shows the fitted order");
+        assert!(conv.contains("b_rel_err_max (isph · paper): order 2.00"), "legend shows the fitted order");
+        let cost = std::fs::read_to_string(out.join("elliptical_drop/cost.svg")).unwrap();
+        // The first series' line, in the palette's first colour (the axes are black).
+        let line = "<polyline fill=\"none\" opacity=\"1\" stroke=\"#1F77B4\"";
+        assert!(cost.contains("isph · paper") && cost.contains(line), "one line per scheme and preset");
         assert!(conv.contains("reference slope dx^2"));
         let hist = std::fs::read_to_string(out.join("elliptical_drop/history_b_paper.svg")).unwrap();
         assert!(hist.contains("b_ref (reference)") && hist.contains("dx=0.02"));

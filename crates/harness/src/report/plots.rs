@@ -281,6 +281,27 @@ fn start_label(r: &RunResult) -> String {
     r.start.map(|seed| format!(", start {seed}")).unwrap_or_default()
 }
 
+/// A series' legend name: `scheme · preset`, so that the schemes read apart on a case page
+/// (the presets of a case name what they change, not always the method).
+fn series_name(scheme: &str, preset: &str) -> String {
+    format!("{scheme} · {preset}")
+}
+
+/// The marker of a run of scheme `$scheme` at `$p` (a `DynElement` in the caller's
+/// coordinates): a disc for ISPH, a triangle for WCSPH, a cross for MPS (another scheme:
+/// a ring), so that a scheme's points read apart when the palette repeats. A
+/// macro, not a function: plotters ties a dynamic element's lifetime to its backend's.
+macro_rules! scheme_marker {
+    ($scheme:expr, $p:expr, $size:expr, $c:expr) => {
+        match $scheme {
+            "isph" => Circle::new($p, $size, $c.filled()).into_dyn(),
+            "wcsph" => TriangleMarker::new($p, $size + 1, $c.filled()).into_dyn(),
+            "mps" => Cross::new($p, $size, $c.stroke_width(2)).into_dyn(),
+            _ => Circle::new($p, $size, $c.stroke_width(2)).into_dyn(),
+        }
+    };
+}
+
 /// Error against dx in log-log: one line per metric and preset (a perturbed-start ensemble
 /// by its mean), labelled with the fitted order, and a reference line of slope `slope` through the finest point of the first.
 pub fn convergence(
@@ -290,15 +311,15 @@ pub fn convergence(
     metrics: &[String],
     slope: Option<f64>,
 ) -> Result<String> {
-    let mut presets: Vec<&str> = runs.iter().map(|r| r.preset.as_str()).collect();
-    presets.dedup();
+    let mut presets: Vec<(&str, &str)> =
+        runs.iter().map(|r| (r.preset.as_str(), r.scheme.as_str())).collect();
     presets.sort_unstable();
     presets.dedup();
-    // (label, colour index, preset index, points coarse -> fine)
+    // (label, colour index, preset index, scheme, points coarse -> fine)
     let mut lines = Vec::new();
     for (mi, m) in metrics.iter().enumerate() {
-        for (pi, p) in presets.iter().enumerate() {
-            let mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == *p).collect();
+        for (pi, &(p, scheme)) in presets.iter().enumerate() {
+            let mine: Vec<&RunResult> = runs.iter().copied().filter(|r| r.preset == p).collect();
             let pts: Vec<(f64, f64)> = crate::checks::per_spacing(&mine, m)
                 .into_iter()
                 .filter_map(|(d, v)| Some((d, v?)))
@@ -309,34 +330,32 @@ pub fn convergence(
             }
             let (dx, e): (Vec<f64>, Vec<f64>) = pts.iter().copied().unzip();
             let order = fit_power_law(&dx, &e).map_or("n/a".to_string(), |f| format!("{:.2}", f.order));
-            lines.push((format!("{m} ({p}): order {order}"), mi, pi, pts));
+            lines.push((format!("{m} ({}): order {order}", series_name(scheme, p)), mi, pi, scheme, pts));
         }
     }
-    let (x0, x1) = log_range(lines.iter().flat_map(|l| l.3.iter().map(|p| p.0)), 1.3);
-    let (y0, y1) = log_range(lines.iter().flat_map(|l| l.3.iter().map(|p| p.1)), 2.0);
+    let (x0, x1) = log_range(lines.iter().flat_map(|l| l.4.iter().map(|p| p.0)), 1.3);
+    let (y0, y1) = log_range(lines.iter().flat_map(|l| l.4.iter().map(|p| p.1)), 2.0);
     svg(|root| {
         let mut chart = log_log(root, title, (x0, x1), (y0, y1), ("dx [m]", "relative error"), Axis::Y)?;
-        for (label, mi, pi, pts) in &lines {
-            let c = colour(*mi);
+        for (label, mi, pi, scheme, pts) in &lines {
+            // Colour per metric, then per preset; the first preset's line bold; the marker
+            // names the scheme.
+            let c = colour(mi + pi);
             let style = if *pi == 0 { c.stroke_width(2) } else { c.stroke_width(1) };
             chart
                 .draw_series(LineSeries::new(pts.clone(), style))
                 .map_err(boxed)?
                 .label(label.clone())
                 .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], style));
-            let marker = *pi;
             chart
-                .draw_series(pts.iter().map(move |&p| -> DynElement<SVGBackend, (f64, f64)> {
-                    if marker == 0 {
-                        Circle::new(p, 4, c.filled()).into_dyn()
-                    } else {
-                        TriangleMarker::new(p, 5, c.filled()).into_dyn()
-                    }
-                }))
+                .draw_series(
+                    pts.iter()
+                        .map(|&p| -> DynElement<SVGBackend, (f64, f64)> { scheme_marker!(*scheme, p, 4, c) }),
+                )
                 .map_err(boxed)?;
         }
         if let (Some(s), Some(first)) = (slope, lines.first()) {
-            let &(dxf, ef) = first.3.last().expect("non-empty");
+            let &(dxf, ef) = first.4.last().expect("non-empty");
             let c = ef / dxf.powf(s);
             let pts: Vec<(f64, f64)> = [x0 * 1.1, x1 / 1.1].iter().map(|&d| (d, c * d.powf(s))).collect();
             let grey = RGBColor(120, 120, 120);
@@ -352,32 +371,53 @@ pub fn convergence(
     .map_err(plot_err(file))
 }
 
-/// Work-precision: wall time against `metric`, one point per run, one colour per preset.
+/// Run time against `metric` (work-precision): one point per run, and per scheme and preset
+/// a line through the means of its spacings (coarse to fine), one colour each; the marker
+/// names the scheme (`scheme_marker!`).
 pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Result<String> {
-    let pts: Vec<(String, f64, f64, f64)> = runs
+    // (preset, scheme, dx, error, wall time)
+    let pts: Vec<(&str, &str, f64, f64, f64)> = runs
         .iter()
         .filter(|r| r.ok())
-        .filter_map(|r| r.metric(metric).map(|e| (r.preset.clone(), r.dx, e, r.wall_s)))
-        .filter(|p| p.2 > 0.0 && p.2.is_finite() && p.3 > 0.0)
+        .filter_map(|r| r.metric(metric).map(|e| (r.preset.as_str(), r.scheme.as_str(), r.dx, e, r.wall_s)))
+        .filter(|p| p.3 > 0.0 && p.3.is_finite() && p.4 > 0.0)
         .collect();
-    let mut presets: Vec<&str> = pts.iter().map(|p| p.0.as_str()).collect();
-    presets.sort_unstable();
-    presets.dedup();
-    let (x0, x1) = log_range(pts.iter().map(|p| p.2), 2.0);
-    let (y0, y1) = log_range(pts.iter().map(|p| p.3), 2.0);
+    let mut series: Vec<(&str, &str)> = pts.iter().map(|p| (p.0, p.1)).collect();
+    series.sort_unstable();
+    series.dedup();
+    let (x0, x1) = log_range(pts.iter().map(|p| p.3), 2.0);
+    let (y0, y1) = log_range(pts.iter().map(|p| p.4), 2.0);
     svg(|root| {
         let mut chart = log_log(root, title, (x0, x1), (y0, y1), (metric, "wall time [s]"), Axis::X)?;
-        for (i, p) in presets.iter().enumerate() {
+        for (i, &(preset, scheme)) in series.iter().enumerate() {
             let c = colour(i);
-            let mine: Vec<&(String, f64, f64, f64)> = pts.iter().filter(|q| q.0 == *p).collect();
+            let mine: Vec<&(&str, &str, f64, f64, f64)> = pts.iter().filter(|q| q.0 == preset).collect();
+            // The mean point of each spacing (several with perturbed starts), coarse to fine.
+            let mut dxs: Vec<f64> = mine.iter().map(|q| q.2).collect();
+            dxs.sort_by(|a, b| b.total_cmp(a));
+            dxs.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
+            let line: Vec<(f64, f64)> = dxs
+                .iter()
+                .map(|&d| {
+                    let at: Vec<_> = mine.iter().filter(|q| (q.2 - d).abs() <= 1e-9 * d.abs()).collect();
+                    let n = at.len() as f64;
+                    (at.iter().map(|q| q.3).sum::<f64>() / n, at.iter().map(|q| q.4).sum::<f64>() / n)
+                })
+                .collect();
+            chart.draw_series(LineSeries::new(line, c.stroke_width(1))).map_err(boxed)?;
+            let marker = scheme.to_string();
             chart
-                .draw_series(mine.iter().map(|q| Circle::new((q.2, q.3), 5, c.filled())))
+                .draw_series(mine.iter().map(|q| -> DynElement<SVGBackend, (f64, f64)> {
+                    scheme_marker!(scheme, (q.3, q.4), 5, c)
+                }))
                 .map_err(boxed)?
-                .label(p.to_string())
-                .legend(move |(x, y)| Circle::new((x + 10, y), 5, c.filled()));
+                .label(series_name(scheme, preset))
+                .legend(move |(x, y)| -> DynElement<SVGBackend, (i32, i32)> {
+                    scheme_marker!(marker.as_str(), (x + 10, y), 5, c)
+                });
             chart
                 .draw_series(mine.iter().map(|q| {
-                    Text::new(format!("dx={}", super::html::format_dx(q.1)), (q.2, q.3), ("sans-serif", 12))
+                    Text::new(format!("dx={}", super::html::format_dx(q.2)), (q.3, q.4), ("sans-serif", 12))
                 }))
                 .map_err(boxed)?;
         }
