@@ -229,8 +229,9 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
             }
         }
         let rows = sys.particle_of.len();
-        // Known pressures: the free surface (zero) and the type-2 walls.
-        sys.singular = rows == solved && total == solved;
+        // Known pressures: the free surface (zero) and the type-2 walls; the
+        // quasi-compressibility's diagonal makes the system regular too.
+        sys.singular = rows == solved && total == solved && self.compressibility == 0.0;
         let (u, p, list, pairs, ops) = (&s.particles.u, &s.particles.p, &s.neighbours, &s.pairs, &self.ops);
         let (row_of, particle_of, density) = (&sys.row_of, &sys.particle_of, &own.density);
         let m = &mut sys.matrix;

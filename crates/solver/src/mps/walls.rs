@@ -39,9 +39,12 @@ pub fn wall_particles<const D: usize>(
 
 /// The no-slip images of the viscous term: a fluid particle `j` within the Laplacian
 /// radius of particle `i`'s side of a wall has an image across the plane with velocity
-/// `−u_j` (both components; Lan Fig. 2). An image is never farther from `i` than `j`
-/// itself, so `i`'s neighbour list (and `i`) hold every `j` whose image counts. Corners
-/// (images across two walls) are not built: the cases' walls are parallel.
+/// `−u_j` (both components; Lan Fig. 2). An image is never nearer to `i` than `j` itself
+/// (`(d_i + d_j)² ≥ (d_i − d_j)²` for particles on the fluid side), so `i`'s neighbour
+/// list (and `i`) hold every `j` whose image counts. Corners (images across two walls) are
+/// not built: the cases' walls are parallel. The wall particles themselves are laid once,
+/// over the initial fluid's extent plus the Laplacian radius: a flow that spreads along a
+/// wall beyond it (a dam break) would find no wall particles there.
 #[derive(Debug, Clone)]
 pub struct Mirror {
     walls: Vec<Wall>,
