@@ -3,8 +3,11 @@
 //! mapping of the scene's `ppe` options onto the linear solver ([`crate::linalg`]).
 
 use crate::error::Cause;
-use crate::linalg::{CsrMatrix, Method, PreconditionerKind, SolveError, SolverParams};
+use crate::linalg::{
+    CsrMatrix, LinearSolver, Method, PreconditionerKind, SolveError, SolveInfo, SolverParams,
+};
 use crate::scene::{PpeOptions, PpeSolver, Preconditioner};
+use rayon::prelude::*;
 
 /// The PPE of the current step: matrix, right-hand side and the particle ↔ row maps.
 #[derive(Debug, Clone, Default)]
@@ -27,6 +30,48 @@ pub struct PpeSystem {
     pub solution: Vec<f64>,
     /// True when no row is Dirichlet-constrained (closed or periodic domain).
     pub singular: bool,
+}
+
+impl PpeSystem {
+    /// Moves each row's (diagonal, right-hand side), as the assembly's pair pass left them
+    /// in `row_out`, into the matrix diagonal, its inverse and `rhs`.
+    pub fn finish_rows(&mut self) {
+        let rows = self.row_out.len();
+        let m = &mut self.matrix;
+        m.diag.resize(rows, 0.0);
+        m.inv_diag.resize(rows, 0.0);
+        self.rhs.resize(rows, 0.0);
+        m.diag
+            .par_iter_mut()
+            .zip(m.inv_diag.par_iter_mut())
+            .zip(self.rhs.par_iter_mut())
+            .zip(self.row_out.par_iter())
+            .with_min_len(512)
+            .for_each(|(((d, inv), r), out)| {
+                (*d, *inv, *r) = (out[0], 1.0 / out[0], out[1]);
+            });
+    }
+
+    /// Solves the system with `solver`, warm-started from the pressures `p` of the rows'
+    /// particles; `key(particle)` keys each row for a coarse space kept across steps (asked
+    /// only when the solver keeps one). The pressures are left in `solution`.
+    pub fn solve(
+        &mut self,
+        solver: &mut LinearSolver,
+        p: &[f64],
+        key: impl Fn(usize) -> u32,
+    ) -> Result<SolveInfo, Cause> {
+        self.solution.clear();
+        self.solution.extend(self.particle_of.iter().map(|&a| p[a as usize]));
+        let keys = if solver.uses_row_keys() {
+            self.row_key.clear();
+            self.row_key.extend(self.particle_of.iter().map(|&a| key(a as usize)));
+            Some(&self.row_key[..])
+        } else {
+            None
+        };
+        solver.solve_keyed(&self.matrix, &self.rhs, &mut self.solution, self.singular, keys).map_err(cause)
+    }
 }
 
 /// The linear solver settings of the scene's PPE options.

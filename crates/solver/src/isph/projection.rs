@@ -145,18 +145,7 @@ impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
             *out = [diag, -div * inv_dt + known + relax];
         };
         par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut sys.row_out, &row);
-        m.diag.resize(rows, 0.0);
-        m.inv_diag.resize(rows, 0.0);
-        sys.rhs.resize(rows, 0.0);
-        m.diag
-            .par_iter_mut()
-            .zip(m.inv_diag.par_iter_mut())
-            .zip(sys.rhs.par_iter_mut())
-            .zip(sys.row_out.par_iter())
-            .with_min_len(512)
-            .for_each(|(((d, inv), r), out)| {
-                (*d, *inv, *r) = (out[0], 1.0 / out[0], out[1]);
-            });
+        sys.finish_rows();
         Ok(())
     }
 }
@@ -180,24 +169,10 @@ impl<const D: usize> Stage<D, IsphData> for PpeSolveStage {
 
     fn run(&mut self, s: &mut State<D>, own: &mut IsphData, _ctx: &StepContext) -> Result<(), Cause> {
         let sys = &mut own.ppe;
-        let p = &mut s.particles.p;
-        sys.solution.resize(sys.particle_of.len(), 0.0);
-        for (x, &a) in sys.solution.iter_mut().zip(&sys.particle_of) {
-            *x = p[a as usize];
-        }
         // The particle ids key the rows for a coarse space kept across steps.
-        let keys = if self.solver.uses_row_keys() {
-            let id = &s.particles.id;
-            sys.row_key.clear();
-            sys.row_key.extend(sys.particle_of.iter().map(|&a| id[a as usize]));
-            Some(&sys.row_key[..])
-        } else {
-            None
-        };
-        s.solve = self
-            .solver
-            .solve_keyed(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular, keys)
-            .map_err(crate::ppe::cause)?;
+        let id = &s.particles.id;
+        s.solve = sys.solve(&mut self.solver, &s.particles.p, |a| id[a])?;
+        let p = &mut s.particles.p;
         // Free-surface particles get p = 0 (or keep their Young–Laplace value); boundary
         // particles keep their known values.
         if !self.surface_pressure {

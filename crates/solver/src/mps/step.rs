@@ -302,18 +302,7 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
             *out = [diag, -source + known];
         };
         par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut sys.row_out, &row);
-        m.diag.resize(rows, 0.0);
-        m.inv_diag.resize(rows, 0.0);
-        sys.rhs.resize(rows, 0.0);
-        m.diag
-            .par_iter_mut()
-            .zip(m.inv_diag.par_iter_mut())
-            .zip(sys.rhs.par_iter_mut())
-            .zip(sys.row_out.par_iter())
-            .with_min_len(512)
-            .for_each(|(((d, inv), r), out)| {
-                (*d, *inv, *r) = (out[0], 1.0 / out[0], out[1]);
-            });
+        sys.finish_rows();
         Ok(())
     }
 }
@@ -336,25 +325,15 @@ impl<const D: usize> Stage<D, MpsData<D>> for PpeSolve {
     fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, _ctx: &StepContext) -> Result<(), Cause> {
         let nf = s.particles.fluid;
         let sys = &mut own.ppe;
-        let p = &mut s.particles.p;
-        sys.solution.clear();
-        sys.solution.extend(sys.particle_of.iter().map(|&i| p[i as usize]));
         // Fluid rows are keyed by particle id, wall rows after every fluid id.
-        let keys = if self.solver.uses_row_keys() {
-            let (id, base) = (&s.particles.id, own.key_base);
-            sys.row_key.clear();
-            sys.row_key.extend(sys.particle_of.iter().map(|&i| {
-                let i = i as usize;
-                if i < nf { id[i] } else { base + (i - nf) as u32 }
-            }));
-            Some(&sys.row_key[..])
-        } else {
-            None
-        };
-        s.solve = self
-            .solver
-            .solve_keyed(&sys.matrix, &sys.rhs, &mut sys.solution, sys.singular, keys)
-            .map_err(crate::ppe::cause)?;
+        let (id, base) = (&s.particles.id, own.key_base);
+        s.solve =
+            sys.solve(
+                &mut self.solver,
+                &s.particles.p,
+                |i| if i < nf { id[i] } else { base + (i - nf) as u32 },
+            )?;
+        let p = &mut s.particles.p;
         let solved = nf + own.type1;
         p[..solved].iter_mut().for_each(|v| *v = 0.0);
         for (v, &i) in sys.solution.iter().zip(&sys.particle_of) {
