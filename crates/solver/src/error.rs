@@ -142,6 +142,18 @@ pub enum Cause {
         /// Reason.
         reason: String,
     },
+    /// An MPS inlet found too few ghost particles to refill the gap behind its pushing
+    /// plate (the outflow lagged the inflow by the whole reserve: the fluid compressed).
+    #[error(
+        "the inlet needs {needed} ghost particles for its next column but {ghosts} are left: the outflow lags the inflow by the whole reserve ({} columns), so the fluid in the channel has compressed",
+        crate::mps::open_channel::RESERVE_COLUMNS
+    )]
+    GhostsExhausted {
+        /// Particles of one inlet column.
+        needed: usize,
+        /// Ghosts left.
+        ghosts: usize,
+    },
     /// The adaptive time step fell below its floor.
     #[error(
         "time step {dt:.3e} s fell below the floor {floor:.3e} s (1e-9 of time.end): the flow is too fast or too viscous for the adaptive step"

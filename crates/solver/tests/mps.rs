@@ -130,3 +130,93 @@ fn mps_is_thread_independent() {
         assert_eq!(a.final_frame, b.final_frame);
     }
 }
+
+/// Lan's open channel (a 2 D × D channel at `rows` rows, Re 40, a plug at U at the start)
+/// with the stabilised MPS options of the `poiseuille_channel` case; periodic across
+/// instead of walled when `walls` is false.
+fn open_channel(rows: usize, walls: bool, end: f64) -> Scene {
+    let (d, u) = (0.2, 2e-4);
+    let dx = d / rows as f64;
+    let mut boundaries = json!({
+        "inflow": {"axis": 0, "position": 0.0, "velocity": u},
+        "outflow": {"axis": 0, "position": 2.0 * d}
+    });
+    if walls {
+        boundaries["walls"] = json!([{"axis": 1, "position": 0.0, "fluid_side": "above"},
+                                     {"axis": 1, "position": d, "fluid_side": "below"}]);
+    } else {
+        boundaries["periodic"] = json!([{"axis": 1, "min": 0.0, "max": d}]);
+    }
+    let v = json!({
+        "name": "open", "dimension": 2, "dx": dx,
+        "kernel": {"kind": "cubic_spline", "h_over_dx": 1.5},
+        "fluid": {"density": 1000.0, "viscosity": 1e-3},
+        "bodies": [{"role": "fluid", "shape": {"rectangle": {"min": [0.0, 0.0], "max": [2.0 * d, d]}},
+                    "velocity": {"affine": {"gradient": [[0.0, 0.0], [0.0, 0.0]], "offset": [u, 0.0]}}}],
+        "boundaries": boundaries,
+        "scheme": {"mps": {"weight": "classic", "gamma": 0.01, "divergence": "corrected",
+                           "pressure_gradient": "minimum", "clip_negative_pressure": true,
+                           "shifting": {"xu": {"coefficient": 0.02}},
+                           "ppe": {"solver": "cg", "tolerance": 1e-6, "max_iterations": 2000}}},
+        "time": {"end": end, "step": {"adaptive": {"cfl": 0.2, "viscous": 0.2, "max": 0.2 * dx / u}}},
+        "probes": [{"mass_balance": {}}],
+        "output": {"probe_every": 1}
+    });
+    Scene::from_json(&v.to_string()).expect("valid scene")
+}
+
+/// The pushing plate and the outlet change the fluid only through the boundaries: after
+/// every step, fluid plus ghosts is the starting count, the fluid count is the start plus
+/// the columns that entered minus the particles that left (the mass-balance fluxes), the
+/// plate and wall particles keep their number, and the plate stays within one stroke of
+/// its start. Over a flow-through of half the channel both planes have passed particles.
+#[test]
+fn the_open_channel_conserves_the_particle_count() {
+    let rows = 12;
+    let scene = open_channel(rows, true, 0.5 * 0.4 / 2e-4);
+    let mut stepper = Stepper::<2>::new(&scene).expect("builds");
+    let (fluid0, total0) = (stepper.state().particles.fluid, stepper.state().particles.total());
+    let (ghosts0, plate) = (own(&stepper).ghosts.len(), own(&stepper).plate);
+    assert_eq!(plate.rows, rows);
+    assert_eq!(
+        plate.type1 + plate.type2,
+        3 * rows,
+        "three plate columns for the classic Laplacian radius 3.1 l0"
+    );
+    let front0 = stepper.state().particles.x[fluid0][0];
+    let mass = 1000.0 * (0.2 / rows as f64).powi(2);
+    while stepper.time() < scene.time.end {
+        stepper.step_once().expect("steps");
+        let s = stepper.state();
+        let (fluid, ghosts) = (s.particles.fluid, own(&stepper).ghosts.len());
+        assert_eq!(
+            fluid + ghosts,
+            fluid0 + ghosts0,
+            "a particle was lost or created at step {}",
+            stepper.steps()
+        );
+        let through = ((s.flux.inflow - s.flux.outflow) / mass).round() as i64;
+        assert_eq!(
+            fluid as i64 - fluid0 as i64,
+            through,
+            "step {}: fluid count against the fluxes",
+            stepper.steps()
+        );
+        assert_eq!(
+            s.particles.total() - fluid,
+            total0 - fluid0,
+            "boundary particles at step {}",
+            stepper.steps()
+        );
+        let front = s.particles.x[fluid][0];
+        assert!(front >= front0 - 1e-12 && front < front0 + 0.2 / rows as f64, "plate front at {front}");
+    }
+    let flux = stepper.state().flux;
+    assert!(flux.inflow > 0.4 * 1000.0 * 2e-4 * 0.2 * scene.time.end, "inflow {}", flux.inflow);
+    assert!(flux.outflow > 0.4 * 1000.0 * 2e-4 * 0.2 * scene.time.end, "outflow {}", flux.outflow);
+}
+
+/// The MPS scheme's own data of a run.
+fn own(st: &Stepper<2>) -> &meniscus::mps::MpsData<2> {
+    st.simulation().method().own().downcast_ref().expect("an MPS run")
+}

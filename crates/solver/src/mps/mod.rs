@@ -11,12 +11,15 @@
 //! `scheme.mps.shifting` only: the kernel's `neighbours`, `free_surface` and `shifting`
 //! of the other schemes (not Lan's MPS: a stabilised variant).
 //!
-//! Particles: the fluid, then the wall particles ([`walls`]: type 1 then type 2), fixed.
+//! Particles: the fluid, then the boundary particles ([`walls`]: type 1 then type 2, fixed;
+//! with an inflow the pushing plate's particles lead each type, [`open_channel`]). With an
+//! inflow and an outflow, `plate_move` follows the predictor and `recycle` ends the step.
 //! The scene's kernel is not used by the step. Time step ([`Mps::stable_step`]):
 //! `Δt = min(α_c l0/|u|_max, α_d λ_L/(2dν), max)`: the CFL limit on the spacing, and the
 //! explicit viscous limit from the Laplacian's Gershgorin bound (`α_d = 1` is the bound;
 //! MPS.md "Time step").
 
+pub mod open_channel;
 pub mod operators;
 pub mod step;
 pub mod walls;
@@ -62,8 +65,13 @@ pub struct Mps {
 /// The scheme's own data, rebuilt every step.
 #[derive(Debug, Default)]
 pub struct MpsData<const D: usize> {
-    /// Number of type-1 wall particles (right after the fluid).
+    /// Number of type-1 boundary particles (right after the fluid; the plate's first).
     pub type1: usize,
+    /// The pushing plate's particles (none without an inflow).
+    pub plate: open_channel::PlateLayout,
+    /// Ids of the ghost particles: parked off the flow (zero mass, in no sum), recycled
+    /// from the outlet to the inlet; fluid plus ghosts is a constant count.
+    pub ghosts: Vec<u32>,
     /// Key of the first wall particle's PPE row for the two-level preconditioner (after
     /// every fluid id).
     pub key_base: u32,
@@ -126,24 +134,42 @@ fn build_with<W: Weight, K: Kernel, const D: usize>(
     let l0 = scene.dx;
     let ops = Operators::<W, D>::new(opts.radii(), l0);
     let reach = ops.reach() + SKIN * l0;
-    let (mut state, _) = crate::setup::particle_state::<D>(scene, kernel.h, kernel.support);
+    let mut state = crate::setup::fluid_state::<D>(scene, kernel.h);
+    let fluid = state.particles.fluid;
+    let open = match (&scene.boundaries.inflow, &scene.boundaries.outflow) {
+        (Some(i), Some(o)) => Some((i, o)),
+        _ => None,
+    };
+    let (plate1, plate2, plate) = match open {
+        Some((inflow, _)) => open_channel::plate(inflow, &state.particles.x[..fluid], l0, ops.re_l, ops.re_g),
+        None => Default::default(),
+    };
     let walls = &scene.boundaries.walls;
     // Type 1: within the gradient radius of the first fluid layer (half a spacing off the
-    // plane); the layers reach the Laplacian radius.
-    let (wall_x, type1) = walls::wall_particles(
-        walls,
-        &state.domain,
-        &state.particles.x[..state.particles.fluid],
-        l0,
-        ops.re_l,
-        ops.re_g - 0.5 * l0,
-    );
-    let key_base = state.particles.fluid as u32;
-    for x in wall_x {
+    // plane); the layers reach the Laplacian radius, over the fluid and the plate.
+    let extent: Vec<Vector<D>> = state.particles.x[..fluid].iter().chain(&plate2).copied().collect();
+    let (wall_x, wall1) =
+        walls::wall_particles(walls, &state.domain, &extent, l0, ops.re_l, ops.re_g - 0.5 * l0);
+    let type1 = plate.type1 + wall1;
+    let mut plate_u = Vector::<D>::zeros();
+    if let Some((inflow, _)) = open {
+        plate_u[inflow.axis] = inflow.velocity;
+    }
+    let boundary = plate1
+        .into_iter()
+        .map(|x| (x, plate_u))
+        .chain(wall_x[..wall1].iter().map(|&x| (x, Vector::zeros())))
+        .chain(plate2.into_iter().map(|x| (x, plate_u)))
+        .chain(wall_x[wall1..].iter().map(|&x| (x, Vector::zeros())));
+    for (x, u) in boundary {
         state.particles.x.push(x);
-        state.particles.u.push(Vector::zeros());
+        state.particles.u.push(u);
         state.particles.p.push(0.0);
     }
+    // Ghost ids after the fluid's; wall rows of the PPE are keyed after both.
+    let reserve = if open.is_some() { open_channel::RESERVE_COLUMNS * plate.rows } else { 0 };
+    let ghosts: Vec<u32> = (fluid as u32..(fluid + reserve) as u32).rev().collect();
+    let key_base = (fluid + reserve) as u32;
     let g = Vector::<D>::from_fn(|i, _| scene.body_force.get(i).copied().unwrap_or(0.0));
     let nu = scene.fluid.viscosity / scene.fluid.density;
     let domain = state.domain;
@@ -154,6 +180,11 @@ fn build_with<W: Weight, K: Kernel, const D: usize>(
         Box::new(Reorder::new(reach, domain, REORDER_EVERY)),
         Box::new(step::Lists::start(ops.reach(), SKIN * l0, domain)),
         Box::new(step::Predictor { ops, nu, g, mirror: walls::Mirror::new(walls) }),
+    ];
+    if let Some((inflow, _)) = open {
+        stages.push(Box::new(open_channel::PlateMove { axis: inflow.axis, speed: inflow.velocity }));
+    }
+    stages.extend::<[Box<dyn Stage<D, MpsData<D>>>; _]>([
         Box::new(step::Lists::provisional(ops.reach(), SKIN * l0, domain)),
         Box::new(step::NumberDensity { ops, beta, auxiliary: opts.free_surface.auxiliary }),
         Box::new(step::PpeAssemble {
@@ -163,7 +194,7 @@ fn build_with<W: Weight, K: Kernel, const D: usize>(
             divergence: opts.divergence,
         }),
         Box::new(step::PpeSolve { solver, clip_negative: opts.clip_negative_pressure }),
-    ];
+    ]);
     if state.particles.total() > state.particles.fluid + type1 {
         stages.push(Box::new(walls::WallPressure { ops, g }));
     }
@@ -176,7 +207,15 @@ fn build_with<W: Weight, K: Kernel, const D: usize>(
         stages.push(Box::new(FreeSurface { threshold }));
         stages.push(Box::new(Shifting::new(law, kernel, threshold)));
     }
-    let own = MpsData { type1, key_base, ..Default::default() };
+    if let Some((inflow, outflow)) = open {
+        let rows = state.particles.x[fluid..fluid + plate.rows].iter().map(|x| {
+            let mut x = *x;
+            x[inflow.axis] += l0;
+            x
+        });
+        stages.push(Box::new(open_channel::Recycle::new(inflow, outflow, rows.collect(), l0)));
+    }
+    let own = MpsData { type1, plate, ghosts, key_base, ..Default::default() };
     let scheme = Mps { l0, nu, lambda: ops.laplacian.lambda, reach };
     Composed { scheme, state, own, stages }
 }

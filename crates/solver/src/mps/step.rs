@@ -68,8 +68,9 @@ impl<const D: usize, O> Stage<D, O> for Lists<D> {
     }
 }
 
-/// MPS.md step 1: `u* = uⁿ + Δt (ν⟨∇²u⟩ⁿ + g)` with the Laplacian over the fluid and its
-/// no-slip wall images (Lan eq. 8, Fig. 2), then `r* = rⁿ + Δt u*`.
+/// MPS.md step 1: `u* = uⁿ + Δt (ν⟨∇²u⟩ⁿ + g)` with the Laplacian over the fluid, its
+/// no-slip wall images (Lan eq. 8, Fig. 2) and the pushing plate (moving at U), then
+/// `r* = rⁿ + Δt u*`.
 #[derive(Debug)]
 pub struct Predictor<W: Weight, const D: usize> {
     /// The operators.
@@ -87,9 +88,10 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Predictor<W, D> {
         "predictor"
     }
 
-    fn run(&mut self, s: &mut State<D>, _own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
+    fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
         let (dt, nf, dom) = (ctx.dt, s.particles.fluid, s.domain);
         let (ops, nu, g, mirror) = (&self.ops, self.nu, self.g, &self.mirror);
+        let (plate, type1) = (own.plate, own.type1);
         let periodic = dom.is_periodic();
         let list = &s.neighbours;
         let part = &mut s.particles;
@@ -110,12 +112,13 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Predictor<W, D> {
                     let mut lap = image(x_i, u_i, &Vector::zeros());
                     for &j in list.of(i) {
                         let j = j as usize;
-                        if j >= nf {
+                        let fluid = j < nf;
+                        if !fluid && !plate.holds(j, nf, type1) {
                             continue;
                         }
                         let r_ij = dom.displacement(&x_old[j], x_i);
                         lap += (u_old[j] - u_i) * ops.laplacian_weight(r_ij.norm());
-                        if !mirror.is_empty() {
+                        if fluid && !mirror.is_empty() {
                             lap += image(&x_old[j], u_old[j], &r_ij);
                         }
                     }

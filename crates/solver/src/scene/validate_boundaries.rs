@@ -117,11 +117,11 @@ fn open_boundaries(scene: &Scene) -> Result<(), SceneError> {
         }
         (Some(i), Some(o)) => (i, o),
     };
-    if !matches!(scene.scheme, Scheme::Isph(_)) {
+    if matches!(scene.scheme, Scheme::Wcsph(_)) {
         return Err(SceneError::new(
             "boundaries.inflow",
             "present",
-            "is supported by the isph scheme only (the wcsph step has no buffer stages yet)",
+            "is supported by the isph and mps schemes only (the wcsph step has no buffer stages yet)",
         ));
     }
     axis("boundaries.inflow.axis", inflow.axis, scene.dimension)?;
