@@ -17,6 +17,7 @@
 //! - A run that was `ok` and now diverged is worse (and the reverse better); a check that
 //!   passed and now fails is *newly failing*.
 
+use crate::case::same_spacing;
 use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::results::{CaseResults, RunResult, case_dirs};
@@ -391,10 +392,7 @@ impl Comparison {
 
 /// Whether two runs are the same point of the sweep: same scheme, preset, dx and start.
 pub fn same_run(a: &RunResult, b: &RunResult) -> bool {
-    a.scheme == b.scheme
-        && a.preset == b.preset
-        && a.start == b.start
-        && (a.dx - b.dx).abs() <= 1e-9 * a.dx.abs().max(b.dx.abs())
+    a.scheme == b.scheme && a.preset == b.preset && a.start == b.start && same_spacing(a.dx, b.dx)
 }
 
 fn compare_run(old: &RunResult, new: &RunResult, band: &NoiseBand) -> RunComparison {

@@ -10,7 +10,9 @@
 //!   "metrics": ["b_rel_err_max", ...], "key_metrics": ["b_rel_err_max"], "convergence": ["b_rel_err_max"],
 //!   "checks": [ { "name": "...", "metric": "b_rel_err_max", "select": { "dx": 0.02, "preset": "paper" }, "max": 0.01 } ],
 //!   "figures": [ { "history": { "file": "history_b", "series": ["b_moment"], "reference": "b_ref" } } ],
-//!   "errata": ["CASES.md erratum 1 ..."] }
+//!   "errata": ["CASES.md erratum 1 ..."],
+//!   "published": [ { "source": "Lan et al. 2022, MPS", "metric": "u_max_station", "preset": "mps_re400",
+//!                    "values": [[0.0025, 0.002822]], "note": "..." } ] }
 //! ```
 //! A preset is a JSON merge patch (RFC 7396, [`crate::patch`]) applied to the template;
 //! the first preset is the case's primary one (its orders go into `convergence`).
@@ -62,6 +64,29 @@ pub struct Case {
     /// Errata of the source papers applied in this case (shown in the report).
     #[serde(default)]
     pub errata: Vec<String>,
+    /// Values the source papers publish for the case's metrics, shown on the case page
+    /// beside the measured ones.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub published: Vec<Published>,
+}
+
+/// A source paper's published values of one metric, one per spacing, compared on the case
+/// page with the runs of one preset (`published[]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Published {
+    /// Where the values come from (paper, table or figure, method).
+    pub source: String,
+    /// The run metric they are values of.
+    pub metric: String,
+    /// The preset whose runs they are compared with.
+    pub preset: String,
+    /// `[dx, value]` pairs, dx \[m\] as the preset runs it (the paper's own spacing goes in
+    /// `note` when it differs).
+    pub values: Vec<[f64; 2]>,
+    /// How the paper's quantity relates to the metric.
+    #[serde(default)]
+    pub note: String,
 }
 
 /// Spacings per tier and the presets run at each spacing.
@@ -129,9 +154,15 @@ fn default_start_fraction() -> f64 {
     1e-12
 }
 
-/// Whether `dx` is one of `spacings` (to 1e-9 relative).
+/// Whether two spacings \[m\] are the same run spacing: equal to 1e-9 relative (a case
+/// file's decimal and a computed `D/36` may differ in the last bits).
+pub fn same_spacing(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
+}
+
+/// Whether `dx` is one of `spacings` ([`same_spacing`]).
 fn listed(spacings: &[f64], dx: f64) -> bool {
-    spacings.iter().any(|&d| (d - dx).abs() <= 1e-9 * d.abs())
+    spacings.iter().any(|&d| same_spacing(d, dx))
 }
 
 /// Where and why a preset diverges (`sweep.presets[].expected_divergence`).
@@ -371,10 +402,8 @@ impl Case {
                         p.name
                     )));
                 }
-                if let Some(d) = e
-                    .dx
-                    .iter()
-                    .find(|&&d| !self.sweep.dx.values().flatten().any(|&s| (s - d).abs() <= 1e-9 * d.abs()))
+                if let Some(d) =
+                    e.dx.iter().find(|&&d| !self.sweep.dx.values().flatten().any(|&s| same_spacing(s, d)))
                 {
                     return Err(err(format!(
                         "preset `{}`: `expected_divergence.dx` has {d}, not a spacing of `sweep.dx`",
@@ -392,6 +421,23 @@ impl Case {
         for (tier, dx) in &self.sweep.dx {
             if let Some(bad) = dx.iter().find(|d| !(d.is_finite() && **d > 0.0)) {
                 return Err(err(format!("sweep.dx.{tier} has {bad}: spacings must be positive")));
+            }
+        }
+        for (i, p) in self.published.iter().enumerate() {
+            let field = format!("published[{i}]");
+            if !names.contains(&p.preset) {
+                return Err(err(format!("`{field}.preset` = {:?} is not a preset of the case", p.preset)));
+            }
+            if !self.metrics.contains(&p.metric) {
+                return Err(err(format!(
+                    "`{field}.metric` = {:?} is not one of the case's `metrics`",
+                    p.metric
+                )));
+            }
+            if let Some([d, _]) =
+                p.values.iter().find(|[d, _]| !self.sweep.dx.values().flatten().any(|&s| same_spacing(s, *d)))
+            {
+                return Err(err(format!("`{field}.values` has dx = {d}, not a spacing of `sweep.dx`")));
             }
         }
         for c in &self.checks {
@@ -460,9 +506,8 @@ impl Case {
                 names.join(", ")
             ));
         }
-        let same = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs();
         if let Some(d) = sel.dx
-            && !self.sweep.dx.values().flatten().any(|&s| same(s, d))
+            && !self.sweep.dx.values().flatten().any(|&s| same_spacing(s, d))
         {
             return Err(format!("`select.dx` = {d} is not a spacing of `sweep.dx`"));
         }
@@ -482,7 +527,7 @@ impl Case {
                 return Err(format!("lists tier `{tier}`, in which preset {p:?} does not run"));
             }
             if let Some(d) = sel.dx
-                && !self.spacings(tier).iter().any(|&s| same(s, d))
+                && !self.spacings(tier).iter().any(|&s| same_spacing(s, d))
             {
                 return Err(format!("lists tier `{tier}`, whose spacings do not include {d}"));
             }

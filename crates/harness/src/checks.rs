@@ -27,6 +27,7 @@
 //! selectors also name the `study` and `case` of a row, and a row's status does not fail
 //! a check.
 
+use crate::case::same_spacing;
 use crate::fit::fit_power_law;
 use crate::results::{CheckResult, RunResult};
 use crate::tier::Tier;
@@ -103,7 +104,7 @@ impl Selector {
     /// Whether `row` matches.
     pub fn matches(&self, row: &impl Checked) -> bool {
         let run = row.run();
-        self.dx.is_none_or(|d| (run.dx - d).abs() <= 1e-9 * d.abs())
+        self.dx.is_none_or(|d| same_spacing(run.dx, d))
             && self.preset.as_ref().is_none_or(|p| *p == run.preset)
             && self.scheme.as_ref().is_none_or(|s| *s == run.scheme)
             && self.study.as_deref().is_none_or(|s| row.study() == Some(s))
@@ -255,7 +256,7 @@ impl CheckSpec {
             let sel = &self.select;
             let runs_here = |pick: &dyn Fn(&RunResult) -> bool| rows.iter().any(|r| pick(r.run()));
             let in_tier = sel.preset.as_ref().is_none_or(|p| runs_here(&|r| r.preset == *p))
-                && sel.dx.is_none_or(|d| runs_here(&|r| (r.dx - d).abs() <= 1e-9 * d.abs()))
+                && sel.dx.is_none_or(|d| runs_here(&|r| same_spacing(r.dx, d)))
                 && sel.scheme.as_ref().is_none_or(|s| runs_here(&|r| r.scheme == *s));
             if !in_tier {
                 return None;
@@ -357,7 +358,7 @@ pub fn per_spacing(runs: &[&RunResult], metric: &str) -> Vec<(f64, Option<f64>)>
     let mut out: Vec<(f64, Vec<Option<f64>>)> = Vec::new();
     for r in runs {
         let v = r.metric(metric).filter(|v| v.is_finite() && r.ok());
-        match out.iter_mut().find(|(d, _)| (d - r.dx).abs() <= 1e-9 * d.abs()) {
+        match out.iter_mut().find(|(d, _)| same_spacing(*d, r.dx)) {
             Some((_, vs)) => vs.push(v),
             None => out.push((r.dx, vec![v])),
         }

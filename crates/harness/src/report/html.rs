@@ -2,7 +2,7 @@
 
 use super::FigureFile;
 use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
-use crate::case::CaseRecord;
+use crate::case::{CaseRecord, Published, same_spacing};
 use crate::results::{CaseResults, CheckResult, RunResult, Summary, Verdict, expected_failures};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
@@ -320,6 +320,9 @@ pub fn case_page(
                 }
             }
         }
+        @if let Some(c) = case {
+            @if !c.published.is_empty() { (published_table(&c.published, &results.runs)) }
+        }
         @if !results.convergence.is_empty() {
             h2 { "Observed orders" }
             p { "Least-squares fit of log(error) against log(dx) over the completed runs (at a spacing with perturbed starts, their mean)." }
@@ -396,6 +399,38 @@ pub fn case_page(
     page(&format!("Meniscus validation: {}", results.case), body)
 }
 
+/// The papers' published values beside the measured ones: per value, the unperturbed run
+/// of its preset at its spacing (blank when that run is not in this tier or diverged).
+fn published_table(published: &[Published], runs: &[RunResult]) -> Markup {
+    html! {
+        h2 { "Published values" }
+        table {
+            tr {
+                th class="l" { "source" } th class="l" { "metric" } th class="l" { "preset" } th { "dx" }
+                th { "published" } th { "measured" } th { "measured / published − 1" }
+            }
+            @for p in published {
+                @for [dx, value] in &p.values {
+                    @let run = runs.iter().find(|r| {
+                        r.preset == p.preset && r.start.is_none() && r.ok() && same_spacing(r.dx, *dx)
+                    });
+                    @let measured = run.and_then(|r| r.metric(&p.metric));
+                    tr {
+                        td class="l" { (p.source) } td class="l" { code { (p.metric) } }
+                        td class="l" { (p.preset) } td { (format_dx(*dx)) }
+                        td { (format!("{value:.4e}")) }
+                        td { (measured.map(|m| format!("{m:.4e}")).unwrap_or_default()) }
+                        td { (measured.map(|m| format!("{:+.2}%", 100.0 * (m / value - 1.0))).unwrap_or_default()) }
+                    }
+                }
+            }
+        }
+        @for p in published.iter().filter(|p| !p.note.is_empty()) {
+            p class="note" { (p.source) ": " (p.note) }
+        }
+    }
+}
+
 /// Key errors of a case for the index: each key metric at the finest spacing of the primary
 /// preset that has a completed run. Where that spacing has perturbed starts, the value is
 /// their mean as the checks and order fits take it ([`crate::checks::per_spacing`]: none
@@ -410,8 +445,7 @@ pub(crate) fn key_errors(results: &CaseResults, record: Option<&CaseRecord>) -> 
     let Some(finest) = runs.iter().filter(|r| r.ok()).map(|r| r.dx).min_by(f64::total_cmp) else {
         return "—".to_string();
     };
-    let members: Vec<&RunResult> =
-        runs.into_iter().filter(|r| (r.dx - finest).abs() <= 1e-9 * finest.abs()).collect();
+    let members: Vec<&RunResult> = runs.into_iter().filter(|r| same_spacing(r.dx, finest)).collect();
     let first = members.iter().find(|r| r.ok()).copied().unwrap_or(members[0]);
     let keys = if keys.is_empty() { first.metrics.keys().take(2).cloned().collect() } else { keys };
     let parts: Vec<String> = keys

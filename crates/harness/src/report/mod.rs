@@ -14,7 +14,7 @@ pub mod timing;
 pub use html::ExtraPage;
 
 use crate::baseline::{self, Comparison, NoiseBand};
-use crate::case::{CaseRecord, Figure};
+use crate::case::{CaseRecord, Figure, same_spacing};
 use crate::error::Result;
 use crate::io;
 use crate::results::{CaseResults, RunResult, Summary, case_dirs};
@@ -117,10 +117,9 @@ fn snapshot_figures(
     dx: Option<f64>,
     figures: &mut Vec<FigureFile>,
 ) -> Result<()> {
-    let close = |a: f64, b: f64| (a - b).abs() <= 1e-9 * b.abs();
     let with_snapshots: Vec<(&RunResult, crate::snapshots::SnapshotFile)> = runs
         .iter()
-        .filter(|r| presets.contains(&r.preset) && dx.is_none_or(|d| close(r.dx, d)))
+        .filter(|r| presets.contains(&r.preset) && dx.is_none_or(|d| same_spacing(r.dx, d)))
         .filter_map(|r| crate::snapshots::load(case_dir, &r.slug()).map(|s| (*r, s)))
         .collect();
     let Some(finest) = with_snapshots.iter().map(|(r, _)| r.dx).min_by(f64::total_cmp) else {
@@ -129,7 +128,7 @@ fn snapshot_figures(
     // Presets in the figure's order, at the chosen spacing.
     let shown: Vec<&crate::snapshots::SnapshotFile> = presets
         .iter()
-        .filter_map(|p| with_snapshots.iter().find(|(r, _)| &r.preset == p && close(r.dx, finest)))
+        .filter_map(|p| with_snapshots.iter().find(|(r, _)| &r.preset == p && same_spacing(r.dx, finest)))
         .map(|(_, s)| s)
         .collect();
     let times = shown.iter().map(|s| s.frames.len()).max().unwrap_or(0);

@@ -1,6 +1,7 @@
 //! SVG figures (plotters, SVG backend only; text is emitted as `<text>` elements, so no
 //! font library is needed). Every function draws from `results.json` data only.
 
+use crate::case::same_spacing;
 use crate::error::{HarnessError, Result};
 use crate::fit::fit_power_law;
 use crate::results::RunResult;
@@ -395,11 +396,11 @@ pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Resul
             // The mean point of each spacing (several with perturbed starts), coarse to fine.
             let mut dxs: Vec<f64> = mine.iter().map(|q| q.2).collect();
             dxs.sort_by(|a, b| b.total_cmp(a));
-            dxs.dedup_by(|a, b| (*a - *b).abs() <= 1e-9 * b.abs());
+            dxs.dedup_by(|a, b| same_spacing(*a, *b));
             let line: Vec<(f64, f64)> = dxs
                 .iter()
                 .map(|&d| {
-                    let at: Vec<_> = mine.iter().filter(|q| (q.2 - d).abs() <= 1e-9 * d.abs()).collect();
+                    let at: Vec<_> = mine.iter().filter(|q| same_spacing(q.2, d)).collect();
                     let n = at.len() as f64;
                     (at.iter().map(|q| q.3).sum::<f64>() / n, at.iter().map(|q| q.4).sum::<f64>() / n)
                 })
