@@ -302,6 +302,8 @@ macro_rules! scheme_marker {
         }
     };
 }
+/// The work-precision study's figures mark their schemes the same way.
+pub(crate) use scheme_marker;
 
 /// Error against dx in log-log: one line per metric and preset (a perturbed-start ensemble
 /// by its mean), labelled with the fitted order, and a reference line of slope `slope` through the finest point of the first.

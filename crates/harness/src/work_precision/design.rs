@@ -8,6 +8,10 @@
 //! to each of its other levels. The sparse LU, which refactorises every step, is pruned
 //! below Δx = 0.04 (see [`Design::for_tier`]). The two presets are also run with one
 //! thread at every spacing of the thread study, for the speed-up.
+//!
+//! Beside the ISPH option sets, the case's presets of the other schemes
+//! ([`SCHEME_PRESETS`]: `wcsph_tuned`, `mps`) run at every spacing of the tier, each scene
+//! built as the validation sweep builds it ([`crate::sweep::spec`]).
 
 use crate::case::Case;
 use crate::error::{HarnessError, Result};
@@ -236,24 +240,82 @@ impl Variant {
     }
 }
 
-/// One planned run: spacing, option set, thread count, and the parts of the design that
+/// A named preset of a case file whose scheme is not ISPH, run as the case file gives it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub struct SchemePreset {
+    /// The scheme: the key of the preset scene's `scheme` object (`wcsph`, `mps`).
+    pub scheme: &'static str,
+    /// The preset's name in the case file.
+    pub preset: &'static str,
+}
+
+/// The drop's presets of the other schemes, run at every spacing of each tier: the tuned
+/// WCSPH and the stabilised MPS (whose `expected_divergence` in the case file names the
+/// spacings where it diverges).
+pub const SCHEME_PRESETS: [SchemePreset; 2] =
+    [SchemePreset { scheme: "wcsph", preset: "wcsph_tuned" }, SchemePreset { scheme: "mps", preset: "mps" }];
+
+/// What a planned drop run runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum Setup {
+    /// An ISPH option set on the case template.
+    Isph(Variant),
+    /// A case preset of another scheme, unchanged.
+    Preset(SchemePreset),
+}
+
+impl Setup {
+    /// The scheme of the run's scene (`isph`, `wcsph`, `mps`).
+    pub fn scheme(&self) -> &'static str {
+        match self {
+            Setup::Isph(_) => "isph",
+            Setup::Preset(p) => p.scheme,
+        }
+    }
+
+    /// The case preset the run is, if any (`paper`, `tuned`, or another scheme's preset).
+    pub fn preset(&self) -> Option<&'static str> {
+        match self {
+            Setup::Isph(v) => v.preset(),
+            Setup::Preset(p) => Some(p.preset),
+        }
+    }
+
+    /// The ISPH option set, if the run is one.
+    pub fn variant(&self) -> Option<Variant> {
+        match self {
+            Setup::Isph(v) => Some(*v),
+            Setup::Preset(_) => None,
+        }
+    }
+
+    /// A short label: the variant's ([`Variant::label`]), or `<scheme> <preset>`.
+    pub fn label(&self) -> String {
+        match self {
+            Setup::Isph(v) => v.label(),
+            Setup::Preset(p) => format!("{} {}", p.scheme, p.preset),
+        }
+    }
+}
+
+/// One planned run: spacing, what it runs, thread count, and the parts of the design that
 /// asked for it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Planned {
     /// Spacing \[m\].
     pub dx: f64,
-    /// Option set.
-    pub variant: Variant,
+    /// ISPH option set or another scheme's preset.
+    pub setup: Setup,
     /// Rayon threads.
     pub threads: usize,
-    /// Design parts: `product`, `ofat:paper`, `ofat:tuned`, `presets`, `threads`.
+    /// Design parts: `product`, `ofat:paper`, `ofat:tuned`, `presets`, `threads`, `schemes`.
     pub groups: Vec<String>,
 }
 
 impl Planned {
-    /// A stable id, e.g. `dx0.02_t2_bicgstab_1e-3-sym-std-xu-fixed`.
+    /// A stable id, e.g. `dx0.02_t2_bicgstab_1e-3-sym-std-xu-fixed` or `dx0.02_t2_mps-mps`.
     pub fn id(&self) -> String {
-        format!("dx{}_t{}_{}", self.dx, self.threads, self.variant.label().replace(' ', "-"))
+        format!("dx{}_t{}_{}", self.dx, self.threads, self.setup.label().replace(' ', "-"))
     }
 }
 
@@ -272,26 +334,32 @@ pub struct Design {
 
 impl Design {
     fn add(&mut self, dx: f64, variant: Variant, threads: usize, group: &str) {
-        let same =
-            |p: &&mut Planned| p.variant == variant && p.threads == threads && (p.dx - dx).abs() < 1e-12;
+        self.add_setup(dx, Setup::Isph(variant), threads, group);
+    }
+
+    fn add_setup(&mut self, dx: f64, setup: Setup, threads: usize, group: &str) {
+        let same = |p: &&mut Planned| p.setup == setup && p.threads == threads && (p.dx - dx).abs() < 1e-12;
         match self.runs.iter_mut().find(|p| same(p)) {
             Some(p) => {
                 if !p.groups.iter().any(|g| g == group) {
                     p.groups.push(group.to_string());
                 }
             }
-            None => self.runs.push(Planned { dx, variant, threads, groups: vec![group.to_string()] }),
+            None => self.runs.push(Planned { dx, setup, threads, groups: vec![group.to_string()] }),
         }
     }
 
     /// The design of `tier` with `threads` threads for the main runs.
     ///
     /// - quick: Δx 0.04 and 0.02; one factor at a time around `tuned` (sparse LU at 0.04
-    ///   only), plus `paper`; the two presets with one thread too (27 runs).
+    ///   only), plus `paper`; the two presets with one thread too (27 ISPH runs).
     /// - default: the Krylov cross product at Δx = 0.04; one factor at a time around both
     ///   presets at 0.04, 0.02 and 0.01 (sparse LU at 0.04, and for `paper` at 0.02); both
-    ///   presets with one thread at 0.04, 0.02, 0.01 (169 runs).
+    ///   presets with one thread at 0.04, 0.02, 0.01 (169 ISPH runs).
     /// - full: the default design plus both presets at Δx = 0.005.
+    ///
+    /// Every tier adds the [`SCHEME_PRESETS`] at each of its [`spacings`], with `threads`
+    /// threads (31, 175 and 179 runs in all).
     pub fn for_tier(tier: Tier, threads: usize) -> Design {
         let mut d = Design {
             runs: Vec::new(),
@@ -348,6 +416,17 @@ impl Design {
                 }
             }
         }
+        for &dx in spacings(tier) {
+            for p in SCHEME_PRESETS {
+                d.add_setup(dx, Setup::Preset(p), threads, "schemes");
+            }
+        }
+        d.description.push(format!(
+            "Other schemes at Δx = {}: the case presets {}, each scene as the validation sweep builds it \
+             (a divergence the case file expects is marked on its row).",
+            spacings(tier).iter().map(|x| x.to_string()).collect::<Vec<_>>().join(", "),
+            SCHEME_PRESETS.map(|p| format!("{} ({})", p.preset, p.scheme.to_uppercase())).join(" and "),
+        ));
         if threads != 1 {
             for &dx in &d.thread_dx.clone() {
                 for (_, p) in presets {
@@ -365,10 +444,29 @@ impl Design {
     }
 }
 
+/// The drop spacings of `tier` \[m\], coarse to fine (those of the work-precision study,
+/// not the case file's sweep).
+pub fn spacings(tier: Tier) -> &'static [f64] {
+    match tier {
+        Tier::Quick => &[0.04, 0.02],
+        Tier::Default => &[0.04, 0.02, 0.01],
+        Tier::Full => &[0.04, 0.02, 0.01, 0.005],
+    }
+}
+
+/// The scene of `setup` at `dx`: an ISPH variant's (`variant_scene`), or the case preset's
+/// as the validation sweep builds it ([`crate::sweep::spec`]).
+pub fn scene(case: &Case, setup: &Setup, dx: f64) -> Result<Scene> {
+    match setup {
+        Setup::Isph(v) => variant_scene(case, v, dx),
+        Setup::Preset(p) => Ok(crate::sweep::spec(case, p.preset, dx)?.scene),
+    }
+}
+
 /// The scene of `variant` at `dx`: the case template with the `paper` preset (the
 /// template itself) at `dx`, the fixed Δt scaled as the case does, then the variant's
 /// options.
-pub fn scene(case: &Case, variant: &Variant, dx: f64) -> Result<Scene> {
+fn variant_scene(case: &Case, variant: &Variant, dx: f64) -> Result<Scene> {
     let value = crate::sweep::effective_scene(case, "paper", dx)?;
     let mut scene = Scene::from_json(&value.to_string()).map_err(|source| HarnessError::Scene {
         case: case.case.clone(),
@@ -396,11 +494,30 @@ mod tests {
         for (name, v) in [("paper", Variant::PAPER), ("tuned", Variant::TUNED)] {
             for dx in [0.04, 0.01] {
                 let spec = crate::sweep::spec(&c, name, dx).unwrap();
-                assert_eq!(scene(&c, &v, dx).unwrap(), spec.scene, "{name} at dx {dx}");
+                assert_eq!(scene(&c, &Setup::Isph(v), dx).unwrap(), spec.scene, "{name} at dx {dx}");
             }
             assert_eq!(v.preset(), Some(name));
         }
         assert!(Variant { dt: Dt::Adaptive, ..Variant::PAPER }.preset().is_none());
+    }
+
+    /// The other schemes' rows run the case file's presets unchanged, at every spacing the
+    /// study reaches (the validation sweep itself stops the drop at 0.02 below the full tier).
+    #[test]
+    fn scheme_presets_match_the_case_file() {
+        let c = committed("elliptical_drop");
+        for p in SCHEME_PRESETS {
+            let setup = Setup::Preset(p);
+            assert_eq!((setup.scheme(), setup.preset(), setup.variant()), (p.scheme, Some(p.preset), None));
+            for &dx in spacings(Tier::Full) {
+                let s = scene(&c, &setup, dx).unwrap();
+                assert_eq!(s, crate::sweep::spec(&c, p.preset, dx).unwrap().scene, "{} at dx {dx}", p.preset);
+                assert_eq!(s.scheme.key(), p.scheme, "{}", p.preset);
+            }
+        }
+        let planned =
+            Planned { dx: 0.02, setup: Setup::Preset(SCHEME_PRESETS[1]), threads: 2, groups: vec![] };
+        assert_eq!(planned.id(), "dx0.02_t2_mps-mps");
     }
 
     #[test]
@@ -413,7 +530,7 @@ mod tests {
             shifting: Shift::None,
             dt: Dt::Adaptive,
         };
-        let s = scene(&c, &v, 0.02).unwrap();
+        let s = scene(&c, &Setup::Isph(v), 0.02).unwrap();
         let Scheme::Isph(o) = &s.scheme else { panic!("an ISPH scene") };
         assert_eq!(o.ppe.solver, PpeSolver::Cg);
         assert_eq!(o.pressure_gradient, PressureGradient::Difference);
@@ -421,7 +538,7 @@ mod tests {
         assert_eq!(o.shifting, Shifting::None);
         assert!(matches!(s.time.step, TimeStep::Adaptive { .. }));
         // The fixed step is scaled with dx below 0.02 as the case does.
-        let fine = scene(&c, &Variant::PAPER, 0.01).unwrap();
+        let fine = scene(&c, &Setup::Isph(Variant::PAPER), 0.01).unwrap();
         assert!(matches!(fine.time.step, TimeStep::Fixed(dt) if (dt - 1e-5).abs() < 1e-18));
     }
 
@@ -437,16 +554,18 @@ mod tests {
         let d = Design::for_tier(Tier::Default, 2);
         let at =
             |dx: f64, t: usize| d.runs.iter().filter(|r| (r.dx - dx).abs() < 1e-12 && r.threads == t).count();
-        // 120 Krylov option sets, and the sparse LU with either preset.
-        assert_eq!(at(0.04, 2), 122);
+        // 120 Krylov option sets, the sparse LU with either preset, and the two other
+        // schemes' presets.
+        assert_eq!(at(0.04, 2), 124);
         // Paper and tuned differ in three factors (solver, divergence, shifting), so they
         // share no neighbour: 11 + 10 option sets, the paper's sparse LU among them.
-        assert_eq!(at(0.02, 2), 21);
-        assert_eq!(at(0.01, 2), 20);
-        assert!(d.runs.iter().filter(|r| r.variant.ppe == Ppe::Direct).all(|r| r.dx >= 0.02));
+        assert_eq!(at(0.02, 2), 23);
+        assert_eq!(at(0.01, 2), 22);
+        let direct = |r: &&Planned| r.setup.variant().is_some_and(|v| v.ppe == Ppe::Direct);
+        assert!(d.runs.iter().filter(direct).all(|r| r.dx >= 0.02));
         assert_eq!(at(0.01, 1), 2);
         assert_eq!(at(0.005, 2), 0);
-        assert_eq!(d.runs.len(), 169);
+        assert_eq!(d.runs.len(), 175);
         let ids: HashSet<String> = d.runs.iter().map(Planned::id).collect();
         assert_eq!(ids.len(), d.runs.len(), "ids are unique");
         assert!(d.runs.windows(2).all(|w| w[0].dx >= w[1].dx), "coarse first");
@@ -456,10 +575,30 @@ mod tests {
         assert!(paper02.groups.contains(&"threads".to_string()));
 
         let full = Design::for_tier(Tier::Full, 2);
-        assert_eq!(full.runs.len(), d.runs.len() + 2);
+        assert_eq!(full.runs.len(), d.runs.len() + 4);
         let quick = Design::for_tier(Tier::Quick, 2);
         assert!(quick.runs.iter().all(|r| r.dx >= 0.02));
-        assert_eq!(quick.runs.len(), 27);
+        assert_eq!(quick.runs.len(), 31);
         assert_eq!(Design::for_tier(Tier::Quick, 1).thread_counts, vec![1]);
+    }
+
+    /// Each tier runs the WCSPH and the MPS preset once at each of its spacings, with the
+    /// main thread count, and nowhere else.
+    #[test]
+    fn every_tier_runs_the_other_schemes_at_each_spacing() {
+        for tier in [Tier::Quick, Tier::Default, Tier::Full] {
+            let d = Design::for_tier(tier, 2);
+            for scheme in ["wcsph", "mps"] {
+                let rows: Vec<&Planned> = d.runs.iter().filter(|r| r.setup.scheme() == scheme).collect();
+                let dx: Vec<f64> = rows.iter().map(|r| r.dx).collect();
+                assert_eq!(dx, spacings(tier), "{scheme} in {tier}");
+                assert!(rows.iter().all(|r| r.threads == 2 && r.groups == ["schemes"]), "{scheme} in {tier}");
+            }
+            assert!(
+                d.description.iter().any(|l| l.contains("wcsph_tuned (WCSPH) and mps (MPS)")),
+                "{:?}",
+                d.description
+            );
+        }
     }
 }

@@ -2,19 +2,20 @@
 //! Poiseuille channel ([`channel`]).
 //!
 //! Every run of a pruned design over spacing × PPE solver and tolerance × gradient form ×
-//! divergence form × shifting × time-step rule ([`design`]) goes through the harness's
-//! runner ([`crate::runner`]), one run at a time, each on a rayon pool of the requested
-//! thread count. Per run the study records wall time, steps, particles, seconds per stage,
+//! divergence form × shifting × time-step rule ([`design`]), and the case's WCSPH and MPS
+//! presets at every spacing, goes through the harness's runner ([`crate::runner`]), one run
+//! at a time, each on a rayon pool of the requested thread count. Per run the study records wall time, steps, particles, seconds per stage,
 //! mean PPE iterations, the process CPU time, the b error at t = 0.008 s against the
 //! ellipse ODE (the harness's elliptical-drop metrics) and the status; a diverged run (or
 //! one whose solver panicked) is a row, never an abort. From the rows alone it then derives
-//! the Pareto front, the cost-per-step fits and the speed-ups and evaluates the performance
-//! issue's targets ([`targets`]), draws the figures ([`plots`]) and writes `results.json`,
+//! the Pareto front of each scheme, the cost-per-step fits and the speed-ups and evaluates
+//! the performance issue's targets ([`targets`]), draws the figures ([`plots`]) and writes
+//! `results.json`,
 //! one SVG per figure and `index.html` into the output directory, atomically
 //! (`results.json` is also rewritten, marked incomplete, after every run, so an interrupted
 //! study keeps what it measured). The channel's runs follow the drop's and are recorded in
-//! the `channel` field of `results.json`, with their own Pareto front and figure; the
-//! targets are the drop's.
+//! the `channel` field of `results.json`, with their own Pareto fronts and figure (an MPS
+//! point beside the ISPH option sets); the targets are the drop's ISPH presets'.
 //!
 //! Reuse: every run's record is cached in `<out>/runs/<id>.json`, but a study measures
 //! every run again by default, so that all its times come from one invocation under one
@@ -145,7 +146,7 @@ pub fn run(opts: &Options) -> Result<Study> {
     let jobs = design
         .runs
         .iter()
-        .map(|p| job(&case, p.id(), p.dx, design::scene(&case, &p.variant, p.dx)?, p.threads))
+        .map(|p| job(&case, p.id(), p.dx, design::scene(&case, &p.setup, p.dx)?, p.threads))
         .collect::<Result<Vec<_>>>()?;
     runner.run(&opts.out, None, &jobs, |i, ran| {
         let row = drop_row(&case, &design.runs[i], &ran)?;
@@ -156,9 +157,7 @@ pub fn run(opts: &Options) -> Result<Study> {
     })?;
     let jobs = channel_runs
         .iter()
-        .map(|p| {
-            job(&channel_case, p.id(), p.dx, channel::scene(&channel_case, &p.variant, p.dx)?, p.threads)
-        })
+        .map(|p| job(&channel_case, p.id(), p.dx, channel::scene(&channel_case, &p.setup, p.dx)?, p.threads))
         .collect::<Result<Vec<_>>>()?;
     runner.run(&opts.out, None, &jobs, |i, ran| {
         let row = channel::row(&channel_case, &channel_runs[i], &ran)?;
@@ -177,13 +176,9 @@ pub fn run(opts: &Options) -> Result<Study> {
     Ok(study)
 }
 
-/// Fills the Pareto front, fits, speed-ups and targets of a study from its runs.
+/// Fills the Pareto fronts, fits, speed-ups and targets of a study from its runs.
 pub fn derive(study: &mut Study, tier: Tier) {
-    let finest = match tier {
-        Tier::Quick => 0.02,
-        Tier::Default => 0.01,
-        Tier::Full => 0.005,
-    };
+    let finest = *design::spacings(tier).last().expect("every tier has spacings");
     study.pareto = targets::pareto_ids(&study.runs, study.threads);
     study.cost_fits = targets::cost_fits(&study.runs, study.threads);
     study.speedups = targets::speedups(&study.runs, study.threads);
@@ -194,15 +189,18 @@ pub fn derive(study: &mut Study, tier: Tier) {
 }
 
 /// The row of a planned drop run from how it ran; a divergence (or a panic inside the
-/// solver) is the row's status.
+/// solver) is the row's status, and one the case file expects of its preset at its spacing
+/// says so.
 fn drop_row(case: &Case, planned: &Planned, ran: &Ran) -> Result<RunRow> {
     let m = measure(case, ran)?;
     let get = |k: &str| m.metrics.get(k).copied();
     Ok(RunRow {
         id: planned.id(),
         dx: planned.dx,
-        variant: planned.variant,
-        preset: planned.variant.preset().map(str::to_string),
+        scheme: planned.setup.scheme().to_string(),
+        variant: planned.setup.variant(),
+        preset: planned.setup.preset().map(str::to_string),
+        expected_divergence: expected_divergence(case, planned),
         threads: planned.threads,
         groups: planned.groups.clone(),
         b_err: get("b_rel_err_final"),
@@ -212,6 +210,14 @@ fn drop_row(case: &Case, planned: &Planned, ran: &Ran) -> Result<RunRow> {
         status: m.status,
         reused: ran.reused(),
     })
+}
+
+/// The case file's reason when the preset a planned drop run is (its scene is the
+/// preset's) is expected to diverge at the run's spacing.
+fn expected_divergence(case: &Case, planned: &Planned) -> Option<String> {
+    let preset = planned.setup.preset()?;
+    let p = case.sweep.presets.iter().find(|p| p.name == preset)?;
+    p.expected_divergence_at(planned.dx).map(str::to_string)
 }
 
 /// What a work-precision row takes from a run: its size and cost, its status, and the
@@ -264,8 +270,11 @@ fn breakdown_bars(study: &Study) -> Vec<(String, &RunRow)> {
                     continue;
                 }
                 let want = Variant { ppe, ..v };
-                if let Some(r) =
-                    study.runs.iter().filter(main).find(|r| r.variant == want && (r.dx - dx).abs() < 1e-12)
+                if let Some(r) = study
+                    .runs
+                    .iter()
+                    .filter(main)
+                    .find(|r| r.variant == Some(want) && (r.dx - dx).abs() < 1e-12)
                 {
                     let suffix = if ppe == Ppe::Bicgstab3 {
                         String::new()
@@ -289,7 +298,7 @@ pub fn figures(study: &Study) -> Result<Vec<page::Figure>> {
             file: "work_precision".into(),
             svg: plots::work_precision("work_precision", &main, &study.pareto)?,
             caption: format!(
-                "Wall time against b error at t = 0.008 s, every finished run with {} threads; the black line joins the Pareto front.",
+                "Wall time against b error at t = 0.008 s, every finished run with {} threads: colour the spacing, marker the scheme (disc ISPH, triangle WCSPH, cross MPS); the black lines join each scheme's Pareto front.",
                 study.threads
             ),
         },
@@ -310,7 +319,7 @@ pub fn figures(study: &Study) -> Result<Vec<page::Figure>> {
             file: "channel_work_precision".into(),
             svg: plots::channel_work_precision("channel_work_precision", &rows, &c.pareto)?,
             caption: format!(
-                "Periodic channel (Re = 4, to τ = νt/D² = 1): wall time against the steady profile error, every finished run with {} threads; the black line joins the Pareto front.",
+                "Periodic channel (Re = 4, to τ = νt/D² = 1): wall time against the steady profile error, every finished run with {} threads: colour the spacing, marker the scheme (disc ISPH, cross MPS); the black lines join each scheme's Pareto front.",
                 study.threads
             ),
         });
@@ -339,6 +348,7 @@ pub fn write(out: &Path, study: &Study) -> Result<()> {
 mod tests {
     use super::*;
     use crate::io::testing::Scratch;
+    use design::Setup;
 
     #[test]
     fn a_tiny_study_writes_well_formed_files() {
@@ -370,27 +380,45 @@ mod tests {
         // A short drop at a coarse spacing: end time cut to 10 steps.
         let mut short = case.clone();
         short.scene["time"]["end"] = serde_json::json!(2e-4);
-        let planned: Vec<Planned> = [(Variant::PAPER, 2), (Variant::TUNED, 2), (Variant::PAPER, 1)]
-            .into_iter()
-            .map(|(variant, threads)| Planned { dx: 0.08, variant, threads, groups: vec!["test".into()] })
-            .collect();
+        let planned: Vec<Planned> = [
+            (Setup::Isph(Variant::PAPER), 2),
+            (Setup::Isph(Variant::TUNED), 2),
+            (Setup::Isph(Variant::PAPER), 1),
+            (Setup::Preset(design::SCHEME_PRESETS[0]), 2),
+            (Setup::Preset(design::SCHEME_PRESETS[1]), 2),
+        ]
+        .into_iter()
+        .map(|(setup, threads)| Planned { dx: 0.08, setup, threads, groups: vec!["test".into()] })
+        .collect();
         let jobs: Vec<Job> = planned
             .iter()
             .map(|p| {
-                job(&short, p.id(), p.dx, design::scene(&short, &p.variant, p.dx).unwrap(), p.threads)
-                    .unwrap()
+                job(&short, p.id(), p.dx, design::scene(&short, &p.setup, p.dx).unwrap(), p.threads).unwrap()
             })
             .collect();
         let finish = |i: usize, ran: Ran| Ok((drop_row(&short, &planned[i], &ran)?, String::new()));
         let runner = Runner::new(Progress::silent(), true, 1);
         for row in runner.run(dir.path(), None, &jobs, finish).unwrap() {
             assert!(row.ok() && !row.reused, "{}", row.status);
-            assert_eq!(row.cost.steps, 10);
-            assert!(row.b_err.unwrap() < 0.05);
-            assert!(row.cost.stages.contains_key("ppe_solve"));
+            assert!(row.b_err.unwrap() < 0.05, "{}: {:?}", row.id, row.b_err);
             assert!(row.cost.cpu_s.is_some_and(|c| c >= 0.0));
+            assert_eq!(row.expected_divergence, None);
+            if row.scheme == "isph" {
+                // The fixed step: 10 steps to 2e-4 s.
+                assert_eq!(row.cost.steps, 10);
+                assert!(row.cost.stages.contains_key("ppe_solve"));
+            } else {
+                assert_eq!(row.variant, None);
+            }
             study.runs.push(row);
         }
+        let schemes: Vec<(&str, Option<&str>)> =
+            study.runs.iter().map(|r| (r.scheme.as_str(), r.preset.as_deref())).collect();
+        assert_eq!(
+            schemes[3..],
+            [("wcsph", Some("wcsph_tuned")), ("mps", Some("mps"))],
+            "the other schemes' rows record scheme and preset"
+        );
         // Resumed: the rows come from the cache, with the times measured then.
         let resumed = Runner::new(Progress::silent(), false, 1).run(dir.path(), None, &jobs, finish).unwrap();
         assert!(resumed.iter().all(|r| r.reused));
@@ -403,10 +431,10 @@ mod tests {
         let ch_case = crate::case::testing::committed("poiseuille_periodic");
         let planned = channel::ChannelPlanned {
             dx: channel::D36,
-            variant: channel::ChannelVariant::IMPLICIT,
+            setup: channel::ChannelSetup::Isph(channel::ChannelVariant::IMPLICIT),
             threads: 1,
         };
-        let scene = channel::scene(&ch_case, &planned.variant, planned.dx).unwrap();
+        let scene = channel::scene(&ch_case, &planned.setup, planned.dx).unwrap();
         let jobs = [job(&ch_case, planned.id(), planned.dx, scene, 1).unwrap()];
         let finish = |_: usize, ran: Ran| Ok((channel::row(&ch_case, &planned, &ran)?, String::new()));
         let row = runner.run(dir.path(), None, &jobs, finish).unwrap().remove(0);
@@ -417,6 +445,8 @@ mod tests {
         study.channel.as_mut().unwrap().runs.push(row);
         derive(&mut study, Tier::Quick);
         assert!(!study.pareto.is_empty());
+        // One front per scheme: the WCSPH and MPS runs are each alone on theirs.
+        assert!(study.pareto.contains(&study.runs[3].id) && study.pareto.contains(&study.runs[4].id));
         assert_eq!(study.channel.as_ref().unwrap().pareto.len(), 1);
         assert_eq!(study.targets.len(), 6);
         write(dir.path(), &study).unwrap();
@@ -424,17 +454,28 @@ mod tests {
         assert!(html.contains("Targets") && html.contains("<svg"));
         assert!(html.contains("1 runs (marked cached)") && html.contains(" (cached)"));
         assert!(html.contains("Periodic channel") && html.contains("re4_implicit"));
+        assert!(html.contains("wcsph_tuned"));
         for f in ["work_precision", "stages", "cost_scaling", "channel_work_precision"] {
             let svg = std::fs::read_to_string(dir.path().join(format!("{f}.svg"))).unwrap();
             assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "{f}");
         }
         let back: Study = io::read_json(&dir.path().join("results.json")).unwrap();
-        assert_eq!(back.runs.len(), 3);
-        assert_eq!(back.runs[0].variant, Variant::PAPER);
-        assert_eq!(back.channel, study.channel);
+        assert_eq!(back, study);
+        assert_eq!(back.runs[0].variant, Some(Variant::PAPER));
         // A file written before the channel study existed still reads.
         let mut old = serde_json::to_value(&study).unwrap();
         old.as_object_mut().unwrap().remove("channel");
         assert_eq!(serde_json::from_value::<Study>(old).unwrap().channel, None);
+        // So does one written before the other schemes: its rows are ISPH.
+        let mut old = serde_json::to_value(&study).unwrap();
+        old["runs"].as_array_mut().unwrap().truncate(3);
+        for rows in ["/runs", "/channel/runs"] {
+            for r in old.pointer_mut(rows).and_then(|v| v.as_array_mut()).unwrap() {
+                r.as_object_mut().unwrap().remove("scheme");
+            }
+        }
+        let old: Study = serde_json::from_value(old).unwrap();
+        assert_eq!(old.runs, study.runs[..3]);
+        assert_eq!(old.channel, study.channel);
     }
 }

@@ -1,15 +1,15 @@
 //! The study's SVG figures (plotters, SVG backend), drawn from the run rows alone.
 //!
 //! The report's chart functions (`crate::report::plots`) take validation `RunResult`s and
-//! draw one kind of chart each; these four need other data (Pareto front, stacked stage
+//! draw one kind of chart each; these four need other data (Pareto fronts, stacked stage
 //! times, fits against particle count, speed-ups), so they live here with the same look
-//! (size, fonts, palette, legend on a translucent box).
+//! (size, fonts, palette, legend on a translucent box, the scheme's marker).
 
 use super::channel::ChannelRow;
 use super::record::{CostFit, RunRow, SpeedUp};
 use super::targets::thresholds;
 use crate::error::{HarnessError, Result};
-use crate::report::plots::colour;
+use crate::report::plots::{colour, scheme_marker};
 use plotters::coord::Shift;
 use plotters::prelude::*;
 
@@ -87,6 +87,11 @@ fn spacings(dx: impl Iterator<Item = f64>) -> Vec<f64> {
 /// One point of a work-precision chart.
 struct Point<'a> {
     id: &'a str,
+    /// The run's scheme (its marker, and its Pareto front).
+    scheme: &'a str,
+    /// The legend entry of the scheme's points: `isph` for the ISPH option sets, the
+    /// series of another scheme's points (`mps · mps`).
+    series: String,
     dx: f64,
     error: f64,
     wall_s: f64,
@@ -99,9 +104,10 @@ fn dx_text(dx: f64) -> String {
     format!("{}", (dx * 1e6).round() / 1e6)
 }
 
-/// Wall time against error (log-log), one colour per spacing; the Pareto front (ids in
-/// `front`, cheapest first) joined by a black line; labelled points; the dashed target
-/// box (error ≤ `target.0` within `target.1` s), if any.
+/// Wall time against error (log-log), one colour per spacing and one marker per scheme
+/// (`scheme_marker!`, with a legend entry per series); each scheme's Pareto front (ids in
+/// `front`, each scheme's cheapest first) joined by a black line; labelled points; the
+/// dashed target box (error ≤ `target.0` within `target.1` s), if any.
 fn front_chart(
     file: &str,
     title: &str,
@@ -140,26 +146,55 @@ fn front_chart(
         }
         for (i, dx) in dxs.iter().enumerate() {
             let c = colour(i);
-            let mine: Vec<(f64, f64)> =
-                pts.iter().filter(|p| (p.dx - dx).abs() < 1e-12).map(|p| (p.error, p.wall_s)).collect();
+            let mine: Vec<&Point> = pts.iter().filter(|p| (p.dx - dx).abs() < 1e-12).collect();
             chart
-                .draw_series(mine.iter().map(|&p| Circle::new(p, 3, c.mix(0.75).filled())))
+                .draw_series(mine.iter().map(|p| -> DynElement<SVGBackend, (f64, f64)> {
+                    scheme_marker!(p.scheme, (p.error, p.wall_s), 3, c.mix(0.75))
+                }))
                 .map_err(boxed)?
                 .label(format!("Δx = {} ({} runs)", dx_text(*dx), mine.len()))
-                .legend(move |(x, y)| Circle::new((x + 10, y), 4, c.filled()));
+                .legend(move |(x, y)| Rectangle::new([(x + 4, y - 4), (x + 12, y + 4)], c.filled()));
         }
-        let front_pts: Vec<(f64, f64)> = front
-            .iter()
-            .filter_map(|id| pts.iter().find(|p| p.id == id))
-            .map(|p| (p.error, p.wall_s))
-            .collect();
+        // One legend entry per series, its marker in grey.
+        let grey = RGBColor(90, 90, 90);
+        let mut series: Vec<(&str, &str)> = Vec::new();
+        for p in pts {
+            if !series.contains(&(p.scheme, p.series.as_str())) {
+                series.push((p.scheme, p.series.as_str()));
+            }
+        }
+        for (scheme, name) in series {
+            let n = pts.iter().filter(|p| p.series == name).count();
+            let marker = scheme.to_string();
+            chart
+                .draw_series(std::iter::empty::<Circle<(f64, f64), i32>>())
+                .map_err(boxed)?
+                .label(format!("{name} ({n} runs)"))
+                .legend(move |(x, y)| -> DynElement<SVGBackend, (i32, i32)> {
+                    scheme_marker!(marker.as_str(), (x + 8, y), 4, grey)
+                });
+        }
+        let mut schemes: Vec<&str> = Vec::new();
+        for id in front {
+            if let Some(p) = pts.iter().find(|p| p.id == id)
+                && !schemes.contains(&p.scheme)
+            {
+                schemes.push(p.scheme);
+            }
+        }
+        let on_front: Vec<&Point> = front.iter().filter_map(|id| pts.iter().find(|p| p.id == id)).collect();
+        for (k, scheme) in schemes.iter().enumerate() {
+            let line: Vec<(f64, f64)> =
+                on_front.iter().filter(|p| p.scheme == *scheme).map(|p| (p.error, p.wall_s)).collect();
+            let drawn = chart.draw_series(LineSeries::new(line, BLACK.stroke_width(2))).map_err(boxed)?;
+            if k == 0 {
+                drawn
+                    .label(format!("Pareto front of each scheme ({} runs)", on_front.len()))
+                    .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
+            }
+        }
         chart
-            .draw_series(LineSeries::new(front_pts.clone(), BLACK.stroke_width(2)))
-            .map_err(boxed)?
-            .label(format!("Pareto front ({} runs)", front_pts.len()))
-            .legend(|(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], BLACK.stroke_width(2)));
-        chart
-            .draw_series(front_pts.iter().map(|&p| Circle::new(p, 6, BLACK.stroke_width(2))))
+            .draw_series(on_front.iter().map(|p| Circle::new((p.error, p.wall_s), 6, BLACK.stroke_width(2))))
             .map_err(boxed)?;
         chart
             .draw_series(pts.iter().filter_map(|p| {
@@ -170,8 +205,17 @@ fn front_chart(
     })
 }
 
+/// The legend entry of a run's scheme: `isph` for every ISPH option set, `scheme · series`
+/// for another scheme's named series.
+fn series(scheme: &str, name: Option<String>) -> String {
+    match name {
+        Some(name) if scheme != "isph" => format!("{scheme} · {name}"),
+        _ => scheme.to_string(),
+    }
+}
+
 /// The drop's chart: wall time against b error at t = 0.008 s (finished runs), the
-/// presets labelled, the target box (b error ≤ 0.5 % within 1 s).
+/// presets labelled, the target box (b error ≤ 0.5 % within 1 s, the ISPH target).
 pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<String> {
     let pts: Vec<Point> = runs
         .iter()
@@ -179,6 +223,8 @@ pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<
         .filter_map(|r| {
             r.b_err.filter(|e| *e > 0.0).map(|error| Point {
                 id: &r.id,
+                scheme: &r.scheme,
+                series: series(&r.scheme, r.preset.clone()),
                 dx: r.dx,
                 error,
                 wall_s: r.cost.wall_s,
@@ -192,12 +238,13 @@ pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<
         "relative b error at t = 0.008 s",
         &pts,
         front,
-        Some((thresholds::B_ERR, thresholds::B_ERR_WALL_S, "target: b error ≤ 0.5 % within 1 s")),
+        Some((thresholds::B_ERR, thresholds::B_ERR_WALL_S, "ISPH target: b error ≤ 0.5 % within 1 s")),
     )
 }
 
 /// The channel's chart: wall time against the steady profile error at τ = 1 (finished
-/// runs), the case's presets (`re4`, `re4_implicit`) labelled.
+/// runs), the case's presets (`re4`, `re4_implicit`) and the other schemes' points
+/// labelled.
 pub fn channel_work_precision(file: &str, runs: &[&ChannelRow], front: &[String]) -> Result<String> {
     let pts: Vec<Point> = runs
         .iter()
@@ -205,10 +252,22 @@ pub fn channel_work_precision(file: &str, runs: &[&ChannelRow], front: &[String]
         .filter_map(|r| {
             r.error.filter(|e| *e > 0.0).map(|error| Point {
                 id: &r.id,
+                scheme: &r.scheme,
+                series: match r.series() {
+                    Some(name) if r.scheme != "isph" => name,
+                    _ => r.scheme.clone(),
+                },
                 dx: r.dx,
                 error,
                 wall_s: r.cost.wall_s,
-                label: r.preset.as_ref().map(|name| format!("{name} Δx={}", dx_text(r.dx))),
+                label: r.preset.as_ref().map(|name| {
+                    let name = if r.scheme == "isph" {
+                        name.clone()
+                    } else {
+                        format!("{} ({name} options)", r.scheme)
+                    };
+                    format!("{name} Δx={}", dx_text(r.dx))
+                }),
             })
         })
         .collect();

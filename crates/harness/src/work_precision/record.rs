@@ -9,15 +9,24 @@ use std::collections::BTreeMap;
 /// One run of the study. A diverged run is a row with its status and no error value.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct RunRow {
-    /// Stable id, e.g. `dx0.02_t2_bicgstab_1e-3-sym-std-xu-fixed`.
+    /// Stable id, e.g. `dx0.02_t2_bicgstab_1e-3-sym-std-xu-fixed` or `dx0.02_t2_mps-mps`.
     pub id: String,
     /// Spacing \[m\].
     pub dx: f64,
-    /// The option set.
+    /// The scheme of the run's scene: `isph`, `wcsph` or `mps` (`isph` in files written
+    /// before the other schemes joined the study).
+    #[serde(default = "isph")]
+    pub scheme: String,
+    /// The ISPH option set; absent for another scheme's preset.
     #[serde(flatten)]
-    pub variant: Variant,
-    /// `paper` or `tuned` when the option set is one of the case's presets.
+    pub variant: Option<Variant>,
+    /// The case preset the run is: `paper` or `tuned` when the ISPH option set is one of
+    /// them, or the other scheme's preset (`wcsph_tuned`, `mps`).
     pub preset: Option<String>,
+    /// The case file's reason when `preset` is expected to diverge at this spacing (its
+    /// `expected_divergence`), so that such a row reads as expected; absent otherwise.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub expected_divergence: Option<String>,
     /// Rayon threads of the run.
     pub threads: usize,
     /// Parts of the design that asked for the run.
@@ -71,6 +80,11 @@ impl Cost {
     pub fn core_us_per_particle_step(&self) -> Option<f64> {
         crate::results::core_us_per_particle_step(self.cpu_s, (self.particles * self.steps) as f64)
     }
+}
+
+/// The scheme of a row in a file written before the study ran other schemes.
+pub(crate) fn isph() -> String {
+    "isph".into()
 }
 
 impl RunRow {

@@ -1,5 +1,7 @@
-//! Derived quantities (Pareto front, cost-per-step fits, speed-ups) and the evaluation of
-//! the performance issue's targets, from the run rows alone.
+//! Derived quantities (Pareto fronts, cost-per-step fits, speed-ups) and the evaluation of
+//! the performance issue's targets, from the run rows alone. The targets, fits and
+//! speed-ups are the ISPH presets' (the issue's); the other schemes' rows enter the Pareto
+//! fronts, one per scheme.
 
 use super::pareto;
 use super::record::{CostFit, RunRow, SpeedUp, Target};
@@ -33,12 +35,14 @@ fn finished(runs: &[RunRow], threads: usize) -> Vec<(&RunRow, (f64, f64))> {
         .collect()
 }
 
-/// Ids of the Pareto-optimal runs in (b error, wall time) among the finished runs with
-/// `threads` threads, cheapest first.
+/// Ids of the Pareto-optimal runs in (b error, wall time) of each scheme among the
+/// finished runs with `threads` threads ([`pareto::fronts_by_scheme`]), each scheme's
+/// cheapest first.
 pub fn pareto_ids(runs: &[RunRow], threads: usize) -> Vec<String> {
     let pts = finished(runs, threads);
+    let schemes: Vec<&str> = pts.iter().map(|p| p.0.scheme.as_str()).collect();
     let xy: Vec<(f64, f64)> = pts.iter().map(|p| p.1).collect();
-    pareto::front(&xy).into_iter().map(|i| pts[i].0.id.clone()).collect()
+    pareto::fronts_by_scheme(&schemes, &xy).into_iter().map(|i| pts[i].0.id.clone()).collect()
 }
 
 /// Cost per step against particle count for each preset, over its finished runs with
@@ -151,14 +155,15 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
         },
     ));
 
-    // 2. The fastest run reaching b error ≤ 0.5 % takes ≤ 1 s.
+    // 2. The fastest ISPH run reaching b error ≤ 0.5 % takes ≤ 1 s (the issue is about the
+    // ISPH solver: another scheme's run does not meet it for ISPH).
     let best = finished(runs, threads)
         .into_iter()
-        .filter(|(_, (e, _))| *e <= B_ERR)
+        .filter(|(r, (e, _))| r.scheme == "isph" && *e <= B_ERR)
         .min_by(|a, b| a.1.1.total_cmp(&b.1.1).then(a.1.0.total_cmp(&b.1.0)));
     let mut t = max_target(
         format!(
-            "fastest run with b error ≤ {} % at t = 0.008 s: wall time ≤ {B_ERR_WALL_S} s",
+            "fastest ISPH run with b error ≤ {} % at t = 0.008 s: wall time ≤ {B_ERR_WALL_S} s",
             B_ERR * 100.0
         ),
         best.map(|(r, _)| r.cost.wall_s),
@@ -166,7 +171,7 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
         "s",
         match best {
             Some((r, (e, _))) => format!("{} (b error {:.3} %)", r.id, e * 100.0),
-            None => format!("no run reached b error ≤ {} %", B_ERR * 100.0),
+            None => format!("no ISPH run reached b error ≤ {} %", B_ERR * 100.0),
         },
     );
     t.pass = Some(t.pass == Some(true));
@@ -261,8 +266,10 @@ mod tests {
         RunRow {
             id: format!("dx{dx}_t{threads}_{}", variant.label().replace(' ', "-")),
             dx,
-            variant,
+            scheme: "isph".into(),
+            variant: Some(variant),
             preset: variant.preset().map(str::to_string),
+            expected_divergence: None,
             threads,
             groups: vec![],
             cost: Cost {
@@ -371,6 +378,21 @@ mod tests {
         let with: f64 =
             ts[2].note.split("with its cost per step over them, ").nth(1).unwrap()[..5].parse().unwrap();
         assert!(with > 1.1 && with < 1.4, "{}", ts[2].note);
+    }
+
+    /// Another scheme's rows have their own Pareto front and meet no ISPH target.
+    #[test]
+    fn other_schemes_have_their_own_front_and_no_target() {
+        let p = Some(Variant::PAPER);
+        let mut mps = row(None, 0.04, 2, 0.05, Some(0.001));
+        (mps.id, mps.scheme, mps.variant, mps.preset) =
+            ("dx0.04_t2_mps-mps".into(), "mps".into(), None, Some("mps".into()));
+        let runs = vec![row(p, 0.04, 2, 0.5, Some(0.004)), row(p, 0.02, 2, 2.0, Some(0.003)), mps];
+        // The MPS run dominates both ISPH runs, which stay on the ISPH front.
+        assert_eq!(pareto_ids(&runs, 2), vec![runs[0].id.clone(), runs[1].id.clone(), runs[2].id.clone()]);
+        let ts = evaluate(&runs, 2, 0.02);
+        assert_eq!(ts[1].value, Some(0.5), "the fastest ISPH run under 0.5 %: {}", ts[1].note);
+        assert_eq!(ts.len(), 6, "no target for the other scheme");
     }
 
     #[test]
