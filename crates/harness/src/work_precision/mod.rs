@@ -9,8 +9,9 @@
 //! ellipse ODE (the harness's elliptical-drop metrics) and the status; a diverged run (or
 //! one whose solver panicked) is a row, never an abort. From the rows alone it then derives
 //! the Pareto front of each scheme, the cost-per-step fits and the speed-ups and evaluates
-//! the performance issue's targets ([`targets`]), draws the figures ([`plots`]) and writes
-//! `results.json`,
+//! the performance issue's targets ([`targets`]), the cost per particle-step of each
+//! scheme's presets against the floor of NUMERICS.md ([`costs`]), draws the figures
+//! ([`plots`]) and writes `results.json`,
 //! one SVG per figure and `index.html` into the output directory, atomically
 //! (`results.json` is also rewritten, marked incomplete, after every run, so an interrupted
 //! study keeps what it measured). The channel's runs follow the drop's and are recorded in
@@ -25,6 +26,7 @@
 //! it ran.
 
 pub mod channel;
+pub mod costs;
 pub mod design;
 pub mod page;
 pub mod pareto;
@@ -114,6 +116,7 @@ pub fn run(opts: &Options) -> Result<Study> {
         speedups: Vec::new(),
         targets: Vec::new(),
         channel: Some(ChannelStudy::new(channel_design)),
+        scheme_costs: Vec::new(),
     });
     let start = Instant::now();
     let total = design.runs.len() + channel_runs.len();
@@ -176,7 +179,8 @@ pub fn run(opts: &Options) -> Result<Study> {
     Ok(study)
 }
 
-/// Fills the Pareto fronts, fits, speed-ups and targets of a study from its runs.
+/// Fills the Pareto fronts, fits, speed-ups, targets and scheme costs of a study from its
+/// runs.
 pub fn derive(study: &mut Study, tier: Tier) {
     let finest = *design::spacings(tier).last().expect("every tier has spacings");
     study.pareto = targets::pareto_ids(&study.runs, study.threads);
@@ -186,6 +190,7 @@ pub fn derive(study: &mut Study, tier: Tier) {
     if let Some(c) = &mut study.channel {
         c.derive();
     }
+    study.scheme_costs = costs::scheme_costs(study);
 }
 
 /// The row of a planned drop run from how it ran; a divergence (or a panic inside the
@@ -375,6 +380,7 @@ mod tests {
             speedups: vec![],
             targets: vec![],
             channel: Some(ChannelStudy::new("test".into())),
+            scheme_costs: vec![],
         };
         let dir = Scratch::new("work-precision");
         // A short drop at a coarse spacing: end time cut to 10 steps.
@@ -449,12 +455,16 @@ mod tests {
         assert!(study.pareto.contains(&study.runs[3].id) && study.pareto.contains(&study.runs[4].id));
         assert_eq!(study.channel.as_ref().unwrap().pareto.len(), 1);
         assert_eq!(study.targets.len(), 6);
+        // Main-thread presets of each scheme, then the channel's (its run has one thread).
+        let costs: Vec<&str> = study.scheme_costs.iter().map(|c| c.series.as_str()).collect();
+        assert_eq!(costs, ["paper", "tuned", "wcsph_tuned", "mps"]);
+        assert!(study.scheme_costs.iter().all(|c| c.floor_ratio.is_some_and(|r| r >= 0.0)));
         write(dir.path(), &study).unwrap();
         let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
         assert!(html.contains("Targets") && html.contains("<svg"));
         assert!(html.contains("1 runs (marked cached)") && html.contains(" (cached)"));
         assert!(html.contains("Periodic channel") && html.contains("re4_implicit"));
-        assert!(html.contains("wcsph_tuned"));
+        assert!(html.contains("Cost per particle-step by scheme") && html.contains("wcsph_tuned"));
         for f in ["work_precision", "stages", "cost_scaling", "channel_work_precision"] {
             let svg = std::fs::read_to_string(dir.path().join(format!("{f}.svg"))).unwrap();
             assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"), "{f}");
@@ -466,8 +476,9 @@ mod tests {
         let mut old = serde_json::to_value(&study).unwrap();
         old.as_object_mut().unwrap().remove("channel");
         assert_eq!(serde_json::from_value::<Study>(old).unwrap().channel, None);
-        // So does one written before the other schemes: its rows are ISPH.
+        // So does one written before the other schemes and their costs: its rows are ISPH.
         let mut old = serde_json::to_value(&study).unwrap();
+        old.as_object_mut().unwrap().remove("scheme_costs");
         old["runs"].as_array_mut().unwrap().truncate(3);
         for rows in ["/runs", "/channel/runs"] {
             for r in old.pointer_mut(rows).and_then(|v| v.as_array_mut()).unwrap() {
@@ -475,6 +486,7 @@ mod tests {
             }
         }
         let old: Study = serde_json::from_value(old).unwrap();
+        assert!(old.scheme_costs.is_empty());
         assert_eq!(old.runs, study.runs[..3]);
         assert_eq!(old.channel, study.channel);
     }

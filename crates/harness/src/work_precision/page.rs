@@ -1,7 +1,7 @@
 //! The study's self-contained HTML page (maud; inline CSS, figures inlined as SVG).
 
 use super::channel::{ChannelRow, ChannelStudy};
-use super::record::{Cost, RunRow, Study};
+use super::record::{Cost, RunRow, SchemeCost, Study};
 use crate::results::FLOOR_CORE_US_PER_PARTICLE_PASS;
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
@@ -72,7 +72,7 @@ fn status_cell(ok: bool, status: &str, expected: Option<&str>) -> Markup {
 
 /// The cells both studies' rows share: threads, particles, steps, wall time \[s\], CPU/wall,
 /// `ms` per step (formatted by the caller), mean PPE iterations, core-µs per particle-step
-/// and its ratio to the floor ([`FLOOR_CORE_US_PER_PARTICLE_PASS`]).
+/// and its ratio to the floor ([`Cost::floor_ratio`]).
 fn cost_cells(threads: usize, c: &Cost, ms: &str) -> Markup {
     html! {
         td { (threads) }
@@ -83,7 +83,7 @@ fn cost_cells(threads: usize, c: &Cost, ms: &str) -> Markup {
         td { (ms) }
         td { (format!("{:.1}", c.ppe_iterations_mean)) }
         td { (c.core_us_per_particle_step().map_or("—".into(), |u| format!("{u:.2}"))) }
-        td { (c.core_us_per_particle_step().map_or("—".into(), |u| format!("{:.1}", u / FLOOR_CORE_US_PER_PARTICLE_PASS))) }
+        td { (c.floor_ratio().map_or("—".into(), |x| format!("{x:.1}"))) }
     }
 }
 
@@ -135,6 +135,43 @@ fn channel_section(c: &ChannelStudy) -> Markup {
                 th { "ms/step" } th { "PPE its" } th { "core-µs per particle-step" } th { "× floor" } th { "profile error (τ = 1)" } th { "start-up max" } th class="l" { "status" }
             }
             @for r in &c.runs { (channel_row(r, c.pareto.contains(&r.id))) }
+        }
+    }
+}
+
+/// The table of each scheme's cost per particle-step on each case ([`SchemeCost`]), and
+/// the floor it is measured against.
+fn scheme_cost_section(costs: &[SchemeCost], threads: usize) -> Markup {
+    let list = |v: Vec<String>| v.join(", ");
+    let opt = |v: Option<f64>, digits: usize| v.map_or("—".into(), |x| format!("{x:.digits$}"));
+    html! {
+        h2 { "Cost per particle-step by scheme" }
+        p {
+            "Per case and per scheme, each named series' CPU time over particles × steps (core-µs per particle-step), from its finished runs with "
+            (threads) " threads, at each spacing and pooled over them (summed core-seconds over summed particle-steps), and its ratio to the floor. "
+            "The floor is NUMERICS.md's (\"Performance floor\", measured on the 2-core machine): one fused pair pass costs about 2.2 ns per pair with "
+            "two threads, 0.42 ms over the drop's 7860 particles at Δx = 0.02 (24 pairs each), so " (format!("{FLOOR_CORE_US_PER_PARTICLE_PASS:.3}"))
+            " core-µs per particle; × floor is how many such passes a step is worth. It counts passes of the ISPH drop's neighbourhood: MPS's "
+            "neighbour lists reach its largest operator radius plus a 0.5 l0 skin, beyond ISPH's 2h = 3 Δx, so one of its passes visits more pairs."
+        }
+        table {
+            tr {
+                th class="l" { "case" } th class="l" { "scheme" } th class="l" { "series" } th class="l" { "Δx" } th class="l" { "particles" }
+                th class="l" { "steps" } th class="l" { "core-µs per particle-step" } th class="l" { "× floor" }
+                th { "pooled core-µs per particle-step" } th { "pooled × floor" }
+            }
+            @for c in costs {
+                tr {
+                    td class="l" { (c.case) } td class="l" { (c.scheme) } td class="l" { (c.series) }
+                    td class="l" { (list(c.spacings.iter().map(|s| format!("{}", (s.dx * 1e6).round() / 1e6)).collect())) }
+                    td class="l" { (list(c.spacings.iter().map(|s| s.particles.to_string()).collect())) }
+                    td class="l" { (list(c.spacings.iter().map(|s| s.steps.to_string()).collect())) }
+                    td class="l" { (list(c.spacings.iter().map(|s| opt(s.core_us_per_particle_step, 3)).collect())) }
+                    td class="l" { (list(c.spacings.iter().map(|s| opt(s.floor_ratio, 1)).collect())) }
+                    td { (opt(c.core_us_per_particle_step, 3)) }
+                    td { (opt(c.floor_ratio, 1)) }
+                }
+            }
         }
     }
 }
@@ -197,6 +234,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                         figcaption { (f.caption) " (" a href=(format!("{}.svg", f.file)) { (f.file) ".svg" } ")" }
                     }
                 }
+                (scheme_cost_section(&study.scheme_costs, study.threads))
                 h2 { "Pareto fronts" }
                 p {
                     "One front per scheme: the runs of a scheme that no other run of that scheme (" (study.threads) " threads) beats on both wall time and b error, cheapest first. "

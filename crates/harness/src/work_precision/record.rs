@@ -3,6 +3,7 @@
 use super::channel::ChannelStudy;
 use super::design::Variant;
 use crate::provenance::Provenance;
+use crate::results::FLOOR_CORE_US_PER_PARTICLE_PASS;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -80,6 +81,12 @@ impl Cost {
     pub fn core_us_per_particle_step(&self) -> Option<f64> {
         crate::results::core_us_per_particle_step(self.cpu_s, (self.particles * self.steps) as f64)
     }
+
+    /// [`Cost::core_us_per_particle_step`] over the floor of NUMERICS.md
+    /// ([`FLOOR_CORE_US_PER_PARTICLE_PASS`]): how many fused pair passes a step is worth.
+    pub fn floor_ratio(&self) -> Option<f64> {
+        self.core_us_per_particle_step().map(|c| c / FLOOR_CORE_US_PER_PARTICLE_PASS)
+    }
 }
 
 /// The scheme of a row in a file written before the study ran other schemes.
@@ -117,6 +124,47 @@ pub struct CostFit {
     pub particles: Vec<usize>,
     /// Seconds per step of the fitted runs.
     pub cost_per_step_s: Vec<f64>,
+}
+
+/// The CPU cost per particle-step of one preset of a scheme on one case of the study,
+/// from its finished runs with the study's main thread count, against the performance
+/// floor of NUMERICS.md ([`FLOOR_CORE_US_PER_PARTICLE_PASS`]).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SchemeCost {
+    /// `elliptical_drop` or `poiseuille_periodic`.
+    pub case: String,
+    /// `isph`, `wcsph` or `mps`.
+    pub scheme: String,
+    /// What ran: the case preset (`paper`, `tuned`, `wcsph_tuned`, `mps`; `re4`,
+    /// `re4_implicit`), or for the channel's other schemes `<scheme> (options of the
+    /// <preset> preset) · re4`.
+    pub series: String,
+    /// Threads of the runs.
+    pub threads: usize,
+    /// Each finished spacing, coarse to fine.
+    pub spacings: Vec<SpacingCost>,
+    /// Over all of them: summed CPU time over summed particles × steps \[core-µs\]; none
+    /// when a run lacks its CPU time.
+    pub core_us_per_particle_step: Option<f64>,
+    /// `core_us_per_particle_step` over the floor: fused pair passes per step.
+    pub floor_ratio: Option<f64>,
+}
+
+/// The cost of one run of a [`SchemeCost`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct SpacingCost {
+    /// Spacing \[m\].
+    pub dx: f64,
+    /// Particles.
+    pub particles: usize,
+    /// Steps.
+    pub steps: usize,
+    /// CPU time of the run \[core-s\].
+    pub cpu_s: Option<f64>,
+    /// `cpu_s / (particles × steps)` \[core-µs\].
+    pub core_us_per_particle_step: Option<f64>,
+    /// `core_us_per_particle_step` over the floor.
+    pub floor_ratio: Option<f64>,
 }
 
 /// Wall time with one thread against the main thread count.
@@ -233,4 +281,8 @@ pub struct Study {
     /// The periodic channel's study (absent in files written before it existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub channel: Option<ChannelStudy>,
+    /// Cost per particle-step of each scheme's presets on each case, against the floor
+    /// (absent in files written before it existed).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub scheme_costs: Vec<SchemeCost>,
 }
