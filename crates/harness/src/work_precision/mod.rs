@@ -355,6 +355,25 @@ mod tests {
     use crate::io::testing::Scratch;
     use design::Setup;
 
+    /// A row of a preset says where the case file expects the preset to diverge (the drop's
+    /// `mps` at its finest spacings), and an option set that is no preset expects nothing.
+    #[test]
+    fn rows_say_where_the_case_file_expects_a_divergence() {
+        let case = crate::case::testing::committed("elliptical_drop");
+        let mps = design::SCHEME_PRESETS[1];
+        let preset = case.sweep.presets.iter().find(|p| p.name == mps.preset).unwrap();
+        let at = |setup: Setup, dx: f64| {
+            expected_divergence(&case, &Planned { dx, setup, threads: 2, groups: vec![] })
+        };
+        let spacings = design::spacings(Tier::Full);
+        for &dx in spacings {
+            assert_eq!(at(Setup::Preset(mps), dx).as_deref(), preset.expected_divergence_at(dx), "dx {dx}");
+        }
+        assert!(spacings.iter().any(|&dx| at(Setup::Preset(mps), dx).is_some()));
+        let adaptive = Variant { dt: design::Dt::Adaptive, ..Variant::PAPER };
+        assert!(spacings.iter().all(|&dx| at(Setup::Isph(adaptive), dx).is_none()));
+    }
+
     #[test]
     fn a_tiny_study_writes_well_formed_files() {
         let case = crate::case::testing::committed("elliptical_drop");

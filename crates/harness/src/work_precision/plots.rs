@@ -5,7 +5,7 @@
 //! times, fits against particle count, speed-ups), so they live here with the same look
 //! (size, fonts, palette, legend on a translucent box, the scheme's marker).
 
-use super::channel::ChannelRow;
+use super::channel::{ChannelRow, PRESET};
 use super::record::{CostFit, RunRow, SpeedUp};
 use super::targets::thresholds;
 use crate::error::{HarnessError, Result};
@@ -116,9 +116,20 @@ fn front_chart(
     front: &[String],
     target: Option<(f64, f64, &str)>,
 ) -> Result<String> {
+    let dxs = spacings(pts.iter().map(|p| p.dx));
+    let mut series: Vec<(&str, &str)> = Vec::new();
+    for p in pts {
+        if !series.contains(&(p.scheme, p.series.as_str())) {
+            series.push((p.scheme, p.series.as_str()));
+        }
+    }
     let (x0, x1) = log_range(pts.iter().map(|p| p.error).chain(target.map(|t| t.0)), 1.6);
     let (y0, y1) = log_range(pts.iter().map(|p| p.wall_s).chain(target.map(|t| t.1)), 1.6);
-    let dxs = spacings(pts.iter().map(|p| p.dx));
+    // Room above the slowest run for the legend (upper right, about 18 px a row of the
+    // plot's 380), so that it hides no point.
+    let rows = usize::from(target.is_some()) + dxs.len() + series.len() + 1;
+    let legend_share = ((18 * rows + 10) as f64 / 380.0).min(0.6);
+    let y1 = y0 * (y1 / y0).powf(1.0 / (1.0 - legend_share));
     svg(file, |root| {
         let mut chart = chart_builder(root, title)
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
@@ -146,10 +157,13 @@ fn front_chart(
         }
         for (i, dx) in dxs.iter().enumerate() {
             let c = colour(i);
-            let mine: Vec<&Point> = pts.iter().filter(|p| (p.dx - dx).abs() < 1e-12).collect();
+            // The ISPH option sets small, the other schemes' few points larger and on top.
+            let mut mine: Vec<&Point> = pts.iter().filter(|p| (p.dx - dx).abs() < 1e-12).collect();
+            mine.sort_by_key(|p| p.scheme != "isph");
             chart
                 .draw_series(mine.iter().map(|p| -> DynElement<SVGBackend, (f64, f64)> {
-                    scheme_marker!(p.scheme, (p.error, p.wall_s), 3, c.mix(0.75))
+                    let size = if p.scheme == "isph" { 3 } else { 5 };
+                    scheme_marker!(p.scheme, (p.error, p.wall_s), size, c.mix(0.75))
                 }))
                 .map_err(boxed)?
                 .label(format!("Δx = {} ({} runs)", dx_text(*dx), mine.len()))
@@ -157,13 +171,7 @@ fn front_chart(
         }
         // One legend entry per series, its marker in grey.
         let grey = RGBColor(90, 90, 90);
-        let mut series: Vec<(&str, &str)> = Vec::new();
-        for p in pts {
-            if !series.contains(&(p.scheme, p.series.as_str())) {
-                series.push((p.scheme, p.series.as_str()));
-            }
-        }
-        for (scheme, name) in series {
+        for &(scheme, name) in &series {
             let n = pts.iter().filter(|p| p.series == name).count();
             let marker = scheme.to_string();
             chart
@@ -261,11 +269,8 @@ pub fn channel_work_precision(file: &str, runs: &[&ChannelRow], front: &[String]
                 error,
                 wall_s: r.cost.wall_s,
                 label: r.preset.as_ref().map(|name| {
-                    let name = if r.scheme == "isph" {
-                        name.clone()
-                    } else {
-                        format!("{} ({name} options)", r.scheme)
-                    };
+                    let name =
+                        if r.scheme == "isph" { name.clone() } else { format!("{} · {PRESET}", r.scheme) };
                     format!("{name} Δx={}", dx_text(r.dx))
                 }),
             })
