@@ -659,4 +659,29 @@ mod tests {
             assert!(e.contains("the check") && e.contains(says), "{edit}: {e}");
         }
     }
+
+    /// Published values name a preset, a metric and spacings of the case: the channel's
+    /// (Lan's u_max) load, and each wrong field is named when the case loads.
+    #[test]
+    fn published_values_name_what_the_case_has() {
+        let channel = testing::committed("poiseuille_channel");
+        assert_eq!(channel.published.len(), 1);
+        assert_eq!(channel.published[0].values.len(), 3);
+        let error = |edit: serde_json::Value| {
+            let mut v = serde_json::to_value(&channel).unwrap();
+            crate::patch::merge_patch(&mut v["published"][0], &edit);
+            Case::from_json(&v.to_string(), Path::new("x.json"))
+                .err()
+                .map(|e| e.to_string())
+                .unwrap_or_default()
+        };
+        for (edit, says) in [
+            (serde_json::json!({"preset": "mps_re500"}), "`published[0].preset` = \"mps_re500\""),
+            (serde_json::json!({"metric": "u_peak"}), "`published[0].metric` = \"u_peak\""),
+            (serde_json::json!({"values": [[0.003, 0.0029]]}), "dx = 0.003"),
+        ] {
+            let e = error(edit.clone());
+            assert!(e.contains(says), "{edit}: {e}");
+        }
+    }
 }
