@@ -17,7 +17,7 @@
 //! - A run that was `ok` and now diverged is worse (and the reverse better); a check that
 //!   passed and now fails is *newly failing*.
 
-use crate::case::same_spacing;
+use crate::checks::same_spacing;
 use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::results::{CaseResults, RunResult, case_dirs};

@@ -17,7 +17,7 @@
 //! A preset is a JSON merge patch (RFC 7396, [`crate::patch`]) applied to the template;
 //! the first preset is the case's primary one (its orders go into `convergence`).
 
-use crate::checks::CheckSpec;
+use crate::checks::{CheckSpec, same_spacing};
 use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::provenance::Provenance;
@@ -152,12 +152,6 @@ pub struct PerturbedStarts {
 
 fn default_start_fraction() -> f64 {
     1e-12
-}
-
-/// Whether two spacings \[m\] are the same run spacing: equal to 1e-9 relative (a case
-/// file's decimal and a computed `D/36` may differ in the last bits).
-pub fn same_spacing(a: f64, b: f64) -> bool {
-    (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
 }
 
 /// Whether `dx` is one of `spacings` ([`same_spacing`]).

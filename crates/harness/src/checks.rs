@@ -27,12 +27,17 @@
 //! selectors also name the `study` and `case` of a row, and a row's status does not fail
 //! a check.
 
-use crate::case::same_spacing;
 use crate::fit::fit_power_law;
 use crate::results::{CheckResult, RunResult};
 use crate::tier::Tier;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+
+/// Whether two spacings \[m\] are the same run spacing: equal to 1e-9 relative (a case
+/// file's decimal and a computed `D/36` may differ in the last bits).
+pub fn same_spacing(a: f64, b: f64) -> bool {
+    (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
+}
 
 /// Kinds of check.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]

@@ -145,14 +145,15 @@ pub enum Cause {
     /// An MPS inlet found too few ghost particles to refill the gap behind its pushing
     /// plate (the outflow lagged the inflow by the whole reserve: the fluid compressed).
     #[error(
-        "the inlet needs {needed} ghost particles for its next column but {ghosts} are left: the outflow lags the inflow by the whole reserve ({} columns), so the fluid in the channel has compressed",
-        crate::mps::open_channel::RESERVE_COLUMNS
+        "the inlet needs {needed} ghost particles for its next column but {ghosts} are left: the outflow lags the inflow by the whole reserve ({reserve} columns), so the fluid in the channel has compressed"
     )]
     GhostsExhausted {
         /// Particles of one inlet column.
         needed: usize,
         /// Ghosts left.
         ghosts: usize,
+        /// Columns of ghosts in reserve at the start.
+        reserve: usize,
     },
     /// The adaptive time step fell below its floor.
     #[error(

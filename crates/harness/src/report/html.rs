@@ -2,7 +2,8 @@
 
 use super::FigureFile;
 use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
-use crate::case::{CaseRecord, Published, same_spacing};
+use crate::case::{CaseRecord, Published};
+use crate::checks::same_spacing;
 use crate::results::{CaseResults, CheckResult, RunResult, Summary, Verdict, expected_failures};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 

@@ -14,7 +14,8 @@ pub mod timing;
 pub use html::ExtraPage;
 
 use crate::baseline::{self, Comparison, NoiseBand};
-use crate::case::{CaseRecord, Figure, same_spacing};
+use crate::case::{CaseRecord, Figure};
+use crate::checks::same_spacing;
 use crate::error::Result;
 use crate::io;
 use crate::results::{CaseResults, RunResult, Summary, case_dirs};

@@ -1,7 +1,7 @@
 //! SVG figures (plotters, SVG backend only; text is emitted as `<text>` elements, so no
 //! font library is needed). Every function draws from `results.json` data only.
 
-use crate::case::same_spacing;
+use crate::checks::same_spacing;
 use crate::error::{HarnessError, Result};
 use crate::fit::fit_power_law;
 use crate::results::RunResult;

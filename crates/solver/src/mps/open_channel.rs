@@ -157,7 +157,11 @@ impl<const D: usize> Stage<D, MpsData<D>> for Recycle<D> {
             return Ok(());
         }
         if jump && own.ghosts.len() < plate.rows {
-            return Err(Cause::GhostsExhausted { needed: plate.rows, ghosts: own.ghosts.len() });
+            return Err(Cause::GhostsExhausted {
+                needed: plate.rows,
+                ghosts: own.ghosts.len(),
+                reserve: RESERVE_COLUMNS,
+            });
         }
         let mass = s.density * s.volume;
         self.tail.clear();
