@@ -260,28 +260,29 @@ pub(crate) fn measure(case: &Case, ran: &Ran) -> Result<Measured> {
     Ok(Measured { cost, status, metrics })
 }
 
-/// The runs shown in the stage breakdown: the presets at every spacing, and the PPE
-/// solver variants of both presets at Δx = 0.02.
+/// The runs shown in the stage breakdown: at every spacing the `paper` and `tuned` presets
+/// (with their own PPE solvers) and the other schemes' presets, and at Δx = 0.02 the
+/// presets with each other PPE solver (labelled by it).
 fn breakdown_bars(study: &Study) -> Vec<(String, &RunRow)> {
     let mut bars = Vec::new();
     let main = |r: &&RunRow| r.threads == study.threads && r.cost.steps > 0;
     let mut dxs: Vec<f64> = study.runs.iter().map(|r| r.dx).collect();
     dxs.sort_by(|a, b| b.total_cmp(a));
     dxs.dedup_by(|a, b| (*a - *b).abs() < 1e-12);
+    let at = |dx: f64| move |r: &&RunRow| (r.dx - dx).abs() < 1e-12;
     for dx in dxs {
         for (name, v) in [("paper", Variant::PAPER), ("tuned", Variant::TUNED)] {
-            for ppe in [Ppe::Bicgstab3, Ppe::Bicgstab5, Ppe::Cg3, Ppe::Direct] {
-                if ppe != Ppe::Bicgstab3 && (dx - 0.02).abs() > 1e-12 {
+            let others =
+                [Ppe::Bicgstab3, Ppe::Bicgstab5, Ppe::Cg3, Ppe::Direct].into_iter().filter(|&p| p != v.ppe);
+            for ppe in std::iter::once(v.ppe).chain(others) {
+                if ppe != v.ppe && (dx - 0.02).abs() > 1e-12 {
                     continue;
                 }
                 let want = Variant { ppe, ..v };
-                if let Some(r) = study
-                    .runs
-                    .iter()
-                    .filter(main)
-                    .find(|r| r.variant == Some(want) && (r.dx - dx).abs() < 1e-12)
+                if let Some(r) =
+                    study.runs.iter().filter(main).filter(at(dx)).find(|r| r.variant == Some(want))
                 {
-                    let suffix = if ppe == Ppe::Bicgstab3 {
+                    let suffix = if ppe == v.ppe {
                         String::new()
                     } else {
                         format!(" {}", want.label().split(' ').next().unwrap_or(""))
@@ -289,6 +290,10 @@ fn breakdown_bars(study: &Study) -> Vec<(String, &RunRow)> {
                     bars.push((format!("{name} Δx={dx}{suffix}"), r));
                 }
             }
+        }
+        for r in study.runs.iter().filter(main).filter(at(dx)).filter(|r| r.variant.is_none()) {
+            let preset = r.preset.as_deref().unwrap_or("");
+            bars.push((format!("{} {preset} Δx={dx}", r.scheme), r));
         }
     }
     bars
@@ -310,7 +315,7 @@ pub fn figures(study: &Study) -> Result<Vec<page::Figure>> {
         page::Figure {
             file: "stages".into(),
             svg: plots::stage_breakdown("stages", &breakdown_bars(study))?,
-            caption: "Seconds per stage divided by particles × steps (µs per particle-step): the presets at every spacing and their PPE solver variants at Δx = 0.02.".into(),
+            caption: "Seconds per stage divided by particles × steps (µs per particle-step): the ISPH presets (with their own PPE solvers) and the WCSPH and MPS presets at every spacing, and the ISPH presets with the other PPE solvers at Δx = 0.02.".into(),
         },
         page::Figure {
             file: "cost_scaling".into(),
@@ -469,6 +474,12 @@ mod tests {
         assert!(row.cost.stages.contains_key("viscosity_implicit"));
         study.channel.as_mut().unwrap().runs.push(row);
         derive(&mut study, Tier::Quick);
+        // The stage breakdown shows the presets with their own solvers and the other schemes.
+        let labels: Vec<String> = breakdown_bars(&study).into_iter().map(|(label, _)| label).collect();
+        assert_eq!(
+            labels,
+            ["paper Δx=0.08", "tuned Δx=0.08", "wcsph wcsph_tuned Δx=0.08", "mps mps Δx=0.08"]
+        );
         assert!(!study.pareto.is_empty());
         // One front per scheme: the WCSPH and MPS runs are each alone on theirs.
         assert!(study.pareto.contains(&study.runs[3].id) && study.pareto.contains(&study.runs[4].id));
