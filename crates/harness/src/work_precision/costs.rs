@@ -84,10 +84,9 @@ fn by_series(case: &str, threads: usize, mut points: Vec<Point>) -> Vec<SchemeCo
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::provenance::Provenance;
     use crate::work_precision::channel::{ChannelRow, ChannelStudy, ChannelVariant};
     use crate::work_precision::design::Variant;
-    use crate::work_precision::record::{Machine, RunRow};
+    use crate::work_precision::record::RunRow;
 
     fn cost(particles: usize, steps: usize, cpu_s: Option<f64>) -> Cost {
         Cost { particles, steps, t_end: 0.008, wall_s: 1.0, cpu_s, ..Cost::default() }
@@ -142,23 +141,9 @@ mod tests {
             channel_row("mps", "mps", 0.004, cost(1000, 100, Some(0.3))),
             channel_row("isph", "re4", 0.004, cost(1000, 100, Some(0.1))),
         ];
-        let study = Study {
-            study: "work_precision".into(),
-            case: "elliptical_drop".into(),
-            tier: "quick".into(),
-            complete: true,
-            error_metric: "b".into(),
-            threads: 2,
-            thread_counts: vec![1, 2],
-            design: vec![],
-            machine: Machine {
-                provenance: Provenance::default(),
-                loadavg_start: None,
-                loadavg_end: None,
-                build: "release".into(),
-            },
-            elapsed_s: 1.0,
-            runs: vec![
+        let study = Study::for_test(
+            vec![],
+            vec![
                 drop_row("mps", Some("mps"), 0.02, 2, cost(8000, 400, Some(3.2)), "ok"),
                 drop_row("mps", Some("mps"), 0.04, 2, cost(2000, 400, Some(0.8)), "ok"),
                 // A diverged run, a one-thread run and an unnamed option set are left out.
@@ -168,13 +153,8 @@ mod tests {
                 drop_row("isph", Some("paper"), 0.02, 2, cost(8000, 400, Some(0.64)), "ok"),
                 drop_row("wcsph", Some("wcsph_tuned"), 0.02, 2, cost(8000, 1200, None), "ok"),
             ],
-            pareto: vec![],
-            cost_fits: vec![],
-            speedups: vec![],
-            targets: vec![],
-            channel: Some(channel),
-            scheme_costs: vec![],
-        };
+            Some(channel),
+        );
         let costs = scheme_costs(&study);
         let names: Vec<(&str, &str, &str)> =
             costs.iter().map(|c| (c.case.as_str(), c.scheme.as_str(), c.series.as_str())).collect();

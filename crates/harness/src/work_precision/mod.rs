@@ -382,30 +382,7 @@ mod tests {
     #[test]
     fn a_tiny_study_writes_well_formed_files() {
         let case = crate::case::testing::committed("elliptical_drop");
-        let mut study = Study {
-            study: "work_precision".into(),
-            case: CASE.into(),
-            tier: "quick".into(),
-            complete: true,
-            error_metric: "b".into(),
-            threads: 2,
-            thread_counts: vec![1, 2],
-            design: vec!["test".into()],
-            machine: Machine {
-                provenance: Provenance::default(),
-                loadavg_start: None,
-                loadavg_end: None,
-                build: "release".into(),
-            },
-            elapsed_s: 1.0,
-            runs: vec![],
-            pareto: vec![],
-            cost_fits: vec![],
-            speedups: vec![],
-            targets: vec![],
-            channel: Some(ChannelStudy::new("test".into())),
-            scheme_costs: vec![],
-        };
+        let mut study = Study::for_test(vec!["test".into()], vec![], Some(ChannelStudy::new("test".into())));
         let dir = Scratch::new("work-precision");
         // A short drop at a coarse spacing: end time cut to 10 steps.
         let mut short = case.clone();

@@ -286,3 +286,35 @@ pub struct Study {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub scheme_costs: Vec<SchemeCost>,
 }
+
+#[cfg(test)]
+impl Study {
+    /// A finished quick-tier study of the drop on two threads with `runs` and the channel
+    /// study `channel`, nothing derived yet: the tests' starting point.
+    pub(crate) fn for_test(design: Vec<String>, runs: Vec<RunRow>, channel: Option<ChannelStudy>) -> Study {
+        Study {
+            study: "work_precision".into(),
+            case: super::CASE.into(),
+            tier: "quick".into(),
+            complete: true,
+            error_metric: "b".into(),
+            threads: 2,
+            thread_counts: vec![1, 2],
+            design,
+            machine: Machine {
+                provenance: Provenance::default(),
+                loadavg_start: None,
+                loadavg_end: None,
+                build: "release".into(),
+            },
+            elapsed_s: 1.0,
+            runs,
+            pareto: vec![],
+            cost_fits: vec![],
+            speedups: vec![],
+            targets: vec![],
+            channel,
+            scheme_costs: vec![],
+        }
+    }
+}
