@@ -3,7 +3,8 @@
 //!
 //! The step, built from the scene: `reorder` (locality) → `neighbour_lists` (lists of every
 //! particle within the largest operator radius plus a skin, at rⁿ; saves rⁿ, uⁿ) →
-//! `predictor` (`u* = uⁿ + Δt(ν⟨∇²u⟩ + g)` with no-slip wall images, `r* = rⁿ + Δt u*`) →
+//! `predictor` (`u* = uⁿ + Δt(ν⟨∇²u⟩ + g)` with no-slip wall images, `r* = rⁿ + Δt u*`;
+//! `predictor_implicit` with `scheme.mps.viscosity: implicit`, [`viscosity`]) →
 //! `neighbour_lists_provisional` (rebuilt only if a particle moved more than half the skin) →
 //! `number_density` (n* at r*, free-surface flags) → `ppe_assemble` → `ppe_solve` (CG or
 //! BiCGSTAB, Jacobi or two-level) → `wall_pressure` (type-2 walls extrapolated; with walls
@@ -17,11 +18,12 @@
 //! The scene's kernel is not used by the step. Time step ([`Mps::stable_step`]):
 //! `Δt = min(α_c l0/|u|_max, α_d λ_L/(2dν), max)`: the CFL limit on the spacing, and the
 //! explicit viscous limit from the Laplacian's Gershgorin bound (`α_d = 1` is the bound;
-//! MPS.md "Time step").
+//! MPS.md "Time step"; none with the implicit viscous term).
 
 pub mod open_channel;
 pub mod operators;
 pub mod step;
+pub mod viscosity;
 pub mod walls;
 pub mod weight;
 
@@ -30,7 +32,7 @@ use crate::fields::{ColumnMut, ColumnRef, Field, Fields};
 use crate::kernel::{Kernel, Scaled};
 use crate::linalg::LinearSolver;
 use crate::scene::Probe;
-use crate::scene::{MpsOptions, MpsWeight, Scene, Scheme as SceneScheme};
+use crate::scene::{MpsOptions, MpsWeight, Scene, Scheme as SceneScheme, ViscousIntegration};
 use crate::scheme::{Adaptive, Composed, Scheme};
 use crate::stage::Stage;
 use crate::stages::free_surface::FreeSurface;
@@ -60,6 +62,8 @@ pub struct Mps {
     lambda: f64,
     /// Radius of the neighbour lists \[m\].
     reach: f64,
+    /// The viscous term is implicit: no viscous time-step limit.
+    implicit_viscosity: bool,
 }
 
 /// The scheme's own data, rebuilt every step.
@@ -114,7 +118,7 @@ impl<const D: usize> Scheme<D> for Mps {
 
     fn stable_step(&self, rule: Adaptive, s: &State<D>, _own: &MpsData<D>) -> f64 {
         let mut dt = rule.max.min(time_step::advective(rule.cfl, self.l0, s.max_speed()));
-        if self.nu > 0.0 {
+        if self.nu > 0.0 && !self.implicit_viscosity {
             dt = dt.min(rule.viscous * self.lambda / (2.0 * D as f64 * self.nu));
         }
         dt
@@ -179,8 +183,14 @@ fn build_with<W: Weight, K: Kernel, const D: usize>(
     let mut stages: Vec<Box<dyn Stage<D, MpsData<D>>>> = vec![
         Box::new(Reorder::new(reach, domain, REORDER_EVERY)),
         Box::new(step::Lists::start(ops.reach(), SKIN * l0, domain)),
-        Box::new(step::Predictor { ops, nu, g, mirror: walls::Mirror::new(walls) }),
     ];
+    let mirror = walls::Mirror::new(walls);
+    let implicit_viscosity = opts.viscosity == ViscousIntegration::Implicit;
+    stages.push(if implicit_viscosity {
+        Box::new(viscosity::ImplicitPredictor::new(ops, nu, g, mirror))
+    } else {
+        Box::new(step::Predictor { ops, nu, g, mirror })
+    });
     if let Some((inflow, _)) = open {
         stages.push(Box::new(open_channel::PlateMove { axis: inflow.axis, speed: inflow.velocity }));
     }
@@ -216,7 +226,7 @@ fn build_with<W: Weight, K: Kernel, const D: usize>(
         stages.push(Box::new(open_channel::Recycle::new(inflow, outflow, rows.collect(), l0)));
     }
     let own = MpsData { type1, plate, ghosts, key_base, ..Default::default() };
-    let scheme = Mps { l0, nu, lambda: ops.laplacian.lambda, reach };
+    let scheme = Mps { l0, nu, lambda: ops.laplacian.lambda, reach, implicit_viscosity };
     Composed { scheme, state, own, stages }
 }
 

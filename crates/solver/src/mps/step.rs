@@ -3,6 +3,7 @@
 //! PPE assembly and solve, velocity and position correction.
 
 use super::operators::Operators;
+use super::viscosity::Terms;
 use super::walls::Mirror;
 use super::weight::Weight;
 use super::{Density, MpsData};
@@ -90,39 +91,25 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Predictor<W, D> {
 
     fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
         let (dt, nf, dom) = (ctx.dt, s.particles.fluid, s.domain);
-        let (ops, nu, g, mirror) = (&self.ops, self.nu, self.g, &self.mirror);
-        let (plate, type1) = (own.plate, own.type1);
+        let (nu, g) = (self.nu, self.g);
         let periodic = dom.is_periodic();
-        let list = &s.neighbours;
         let part = &mut s.particles;
+        let terms = Terms {
+            ops: &self.ops,
+            mirror: &self.mirror,
+            list: &s.neighbours,
+            x: &part.x_old,
+            fluid: nf,
+            plate: own.plate,
+            type1: own.type1,
+            domain: dom,
+        };
         let (x_old, u_old, u, x) = (&part.x_old, &part.u_old, &mut part.u, &mut part.x);
         u[..nf].par_iter_mut().zip(x[..nf].par_iter_mut()).enumerate().with_min_len(256).for_each(
             |(i, (u, x))| {
                 let mut a = g;
                 if nu > 0.0 {
-                    let (x_i, u_i) = (&x_old[i], u_old[i]);
-                    // The images of j (velocity −u_j) across the walls near i.
-                    let image = |x_j: &Vector<D>, u_j: Vector<D>, r_ij: &Vector<D>| {
-                        let mut sum = Vector::<D>::zeros();
-                        mirror.images(x_i, x_j, r_ij, ops.re_l, |r2| {
-                            sum -= (u_j + u_i) * ops.laplacian_weight(r2.sqrt());
-                        });
-                        sum
-                    };
-                    let mut lap = image(x_i, u_i, &Vector::zeros());
-                    for &j in list.of(i) {
-                        let j = j as usize;
-                        let fluid = j < nf;
-                        if !fluid && !plate.holds(j, nf, type1) {
-                            continue;
-                        }
-                        let r_ij = dom.displacement(&x_old[j], x_i);
-                        lap += (u_old[j] - u_i) * ops.laplacian_weight(r_ij.norm());
-                        if fluid && !mirror.is_empty() {
-                            lap += image(&x_old[j], u_old[j], &r_ij);
-                        }
-                    }
-                    a += lap * nu;
+                    a += terms.laplacian(i, u_old) * nu;
                 }
                 *u = u_old[i] + a * dt;
                 *x = x_old[i] + *u * dt;

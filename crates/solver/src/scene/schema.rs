@@ -408,6 +408,10 @@ pub struct MpsOptions {
     /// not part of Lan's MPS; the shift's neighbour sums use the scene's kernel.
     #[serde(default)]
     pub shifting: Shifting,
+    /// Time integration of the viscous term: explicit (Lan, the default) or backward Euler
+    /// (`mps::viscosity::ImplicitPredictor`: no viscous time-step limit; not Lan's).
+    #[serde(default)]
+    pub viscosity: ViscousIntegration,
     /// Pressure Poisson solver (CG: the matrix is symmetric positive definite).
     pub ppe: PpeOptions,
 }
