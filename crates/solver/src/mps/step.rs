@@ -123,9 +123,16 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Predictor<W, D> {
 }
 
 /// MPS.md steps 2–3: the number density `n*` at r* (Lan eq. 9) of every particle and the
-/// free-surface flags (read for the fluid and the type-1 walls): `n* < β n0`, or with the
-/// auxiliary criterion `n* < 0.8 n0`, or `n* ≤ β n0` and `|F| > 0.9 |F|0`. Fills the pair
-/// cache at r* that the PPE, the wall pressures and the correction read.
+/// free-surface flags of the fluid: `n* < β n0`, or with the auxiliary criterion
+/// `n* < 0.8 n0`, or `n* ≤ β n0` and `|F| > 0.9 |F|0`. Fills the pair cache at r* that the
+/// PPE, the wall pressures and the correction read.
+///
+/// Boundary particles are never free surface (Koshizuka's code tests type-1 walls too, so
+/// that a tank's walls above the water line hold P = 0; no case here has a wall meeting a
+/// free surface): their deficit is the domain's edge, not air. Beside an inlet's plate the
+/// type-1 walls border the void behind the plate; read as surface they pinned P = 0 two
+/// spacings from the inlet corner, and the channel at Re 40 over 3 m diverged there at
+/// every spacing (docs/notes/mps.md).
 #[derive(Debug)]
 pub struct NumberDensity<W: Weight, const D: usize> {
     /// The operators.
@@ -145,6 +152,7 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for NumberDensity<W, D> {
         let (x, list, dom, ops) = (&s.particles.x, &s.neighbours, s.domain, &self.ops);
         let n0 = ops.number_density.n0;
         let (beta, auxiliary) = (self.beta, self.auxiliary);
+        let nf = s.particles.fluid;
         let f0 = ops.number_density.surface_f;
         s.pairs.resize(list.pairs(), Pair::default());
         own.density.resize(s.particles.total(), Density::default());
@@ -172,10 +180,10 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for NumberDensity<W, D> {
                 } else {
                     sum < beta * n0
                 };
-                *out = Density { n: sum, surface };
+                // Only fluid particles: a boundary particle's deficit is the domain's edge.
+                *out = Density { n: sum, surface: surface && i < nf };
             },
         );
-        let nf = s.particles.fluid;
         s.particles.free_surface.resize(nf, false);
         s.particles.free_surface.iter_mut().zip(&own.density).for_each(|(f, d)| *f = d.surface);
         Ok(())
