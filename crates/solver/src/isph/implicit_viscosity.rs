@@ -14,16 +14,11 @@
 
 use crate::boundary_map::Link;
 use crate::error::Cause;
-use crate::linalg::{
-    CsrMatrix, LinearSolver, Method, PreconditionerKind, SolverParams, par_csr_rows_mut, stored,
-};
+use crate::linalg::{CsrMatrix, LinearSolver, SolverParams, par_csr_rows_mut, stored};
 use crate::operators::ShaoLo;
 use crate::stage::{Stage, StepContext};
 use crate::state::State;
 use rayon::prelude::*;
-
-/// Relative residual tolerance of the viscous solves (well below the PPE's).
-const TOLERANCE: f64 = 1e-8;
 
 /// The implicit viscous predictor stage.
 #[derive(Debug)]
@@ -38,17 +33,10 @@ pub struct ImplicitViscosity {
 impl ImplicitViscosity {
     /// A stage for kinematic viscosity `nu` = μ/ρ \[m²/s\].
     pub fn new(nu: f64) -> Self {
-        let params = SolverParams {
-            method: Method::Cg,
-            tolerance: TOLERANCE,
-            max_iterations: 2000,
-            preconditioner: PreconditionerKind::Jacobi,
-            coarse_refresh: 1,
-        };
         Self {
             nu,
             matrix: CsrMatrix::default(),
-            solver: LinearSolver::new(params).measuring_residual(false),
+            solver: LinearSolver::new(SolverParams::viscous()).measuring_residual(false),
             rhs: Vec::new(),
             x: Vec::new(),
         }

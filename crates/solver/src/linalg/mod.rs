@@ -74,6 +74,21 @@ pub struct SolverParams {
     pub coarse_refresh: usize,
 }
 
+impl SolverParams {
+    /// The implicit viscous solves (ISPH's and MPS's): CG with Jacobi to a relative residual
+    /// of 1e-8 (well below the PPE's: the matrix `I − Δt ν L` is symmetric and diagonally
+    /// dominant, so a few iterations reach it).
+    pub fn viscous() -> Self {
+        Self {
+            method: Method::Cg,
+            tolerance: 1e-8,
+            max_iterations: 2000,
+            preconditioner: PreconditionerKind::Jacobi,
+            coarse_refresh: 1,
+        }
+    }
+}
+
 /// What a solve did.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct SolveInfo {

@@ -186,10 +186,11 @@ fn build_with<W: Weight, K: Kernel, const D: usize>(
     ];
     let mirror = walls::Mirror::new(walls);
     let implicit_viscosity = opts.viscosity == ViscousIntegration::Implicit;
+    let predictor = viscosity::Predictor { ops, nu, g, mirror };
     stages.push(if implicit_viscosity {
-        Box::new(viscosity::ImplicitPredictor::new(ops, nu, g, mirror))
+        Box::new(viscosity::ImplicitPredictor::new(predictor))
     } else {
-        Box::new(step::Predictor { ops, nu, g, mirror })
+        Box::new(predictor)
     });
     if let Some((inflow, _)) = open {
         stages.push(Box::new(open_channel::PlateMove { axis: inflow.axis, speed: inflow.velocity }));

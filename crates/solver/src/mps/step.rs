@@ -1,10 +1,8 @@
 //! The stages of the semi-implicit MPS step (MPS.md "Step"; Koshizuka & Oka 1996 with Lan
-//! 2022's operators and PPE): neighbour lists, predictor, number density and free surface,
-//! PPE assembly and solve, velocity and position correction.
+//! 2022's operators and PPE): neighbour lists, number density and free surface,
+//! PPE assembly and solve, velocity and position correction (the predictor: [`super::viscosity`]).
 
 use super::operators::Operators;
-use super::viscosity::Terms;
-use super::walls::Mirror;
 use super::weight::Weight;
 use super::{Density, MpsData};
 use crate::error::Cause;
@@ -65,59 +63,6 @@ impl<const D: usize, O> Stage<D, O> for Lists<D> {
             p.u_old.clone_from(&p.u);
         }
         self.search.build_rows(&p.x, p.total(), &mut s.neighbours);
-        Ok(())
-    }
-}
-
-/// MPS.md step 1: `u* = uⁿ + Δt (ν⟨∇²u⟩ⁿ + g)` with the Laplacian over the fluid, its
-/// no-slip wall images (Lan eq. 8, Fig. 2) and the pushing plate (moving at U), then
-/// `r* = rⁿ + Δt u*`.
-#[derive(Debug)]
-pub struct Predictor<W: Weight, const D: usize> {
-    /// The operators.
-    pub ops: Operators<W, D>,
-    /// Kinematic viscosity ν \[m²/s\].
-    pub nu: f64,
-    /// Body force per unit mass \[m/s²\].
-    pub g: Vector<D>,
-    /// The walls' no-slip images.
-    pub mirror: Mirror,
-}
-
-impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Predictor<W, D> {
-    fn name(&self) -> &'static str {
-        "predictor"
-    }
-
-    fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
-        let (dt, nf, dom) = (ctx.dt, s.particles.fluid, s.domain);
-        let (nu, g) = (self.nu, self.g);
-        let periodic = dom.is_periodic();
-        let part = &mut s.particles;
-        let terms = Terms {
-            ops: &self.ops,
-            mirror: &self.mirror,
-            list: &s.neighbours,
-            x: &part.x_old,
-            fluid: nf,
-            plate: own.plate,
-            type1: own.type1,
-            domain: dom,
-        };
-        let (x_old, u_old, u, x) = (&part.x_old, &part.u_old, &mut part.u, &mut part.x);
-        u[..nf].par_iter_mut().zip(x[..nf].par_iter_mut()).enumerate().with_min_len(256).for_each(
-            |(i, (u, x))| {
-                let mut a = g;
-                if nu > 0.0 {
-                    a += terms.laplacian(i, u_old) * nu;
-                }
-                *u = u_old[i] + a * dt;
-                *x = x_old[i] + *u * dt;
-                if periodic {
-                    dom.wrap(x);
-                }
-            },
-        );
         Ok(())
     }
 }

@@ -1,7 +1,7 @@
 //! The viscous term of the MPS predictor (MPS.md step 1): the Laplacian of Lan eq. 8,
 //! `⟨∇²u⟩_i = (2d/(λ n0)) Σ_j (u_j − u_i) w_ij`, over the fluid, the no-slip images of the
 //! fluid across the walls (Lan Fig. 2: velocity −u_j) and the pushing plate (moving at U),
-//! taken explicitly ([`super::step::Predictor`]) or implicitly ([`ImplicitPredictor`]).
+//! taken explicitly ([`Predictor`]) or implicitly ([`ImplicitPredictor`]).
 
 use super::MpsData;
 use super::open_channel::PlateLayout;
@@ -9,17 +9,11 @@ use super::operators::Operators;
 use super::walls::Mirror;
 use super::weight::Weight;
 use crate::error::Cause;
-use crate::linalg::{
-    CsrMatrix, LinearSolver, Method, PreconditionerKind, SolverParams, par_csr_rows_mut, stored,
-};
+use crate::linalg::{CsrMatrix, LinearSolver, SolverParams, par_csr_rows_mut, stored};
 use crate::neighbours::{Domain, NeighbourList};
 use crate::stage::{Stage, StepContext};
 use crate::state::{State, Vector};
 use rayon::prelude::*;
-
-/// Relative residual tolerance of the implicit viscous solves (well below the PPE's, as
-/// ISPH's implicit viscosity).
-const TOLERANCE: f64 = 1e-8;
 
 /// One term of fluid particle i's Laplacian, with its factor `(2d/(λ n0)) w` \[1/m²\].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -101,6 +95,65 @@ impl<W: Weight, const D: usize> Terms<'_, W, D> {
     }
 }
 
+/// MPS.md step 1: `u* = uⁿ + Δt (ν⟨∇²u⟩ⁿ + g)` with the Laplacian over the fluid, its
+/// no-slip wall images (Lan eq. 8, Fig. 2) and the pushing plate (moving at U), then
+/// `r* = rⁿ + Δt u*`.
+#[derive(Debug)]
+pub struct Predictor<W: Weight, const D: usize> {
+    /// The operators.
+    pub ops: Operators<W, D>,
+    /// Kinematic viscosity ν \[m²/s\].
+    pub nu: f64,
+    /// Body force per unit mass \[m/s²\].
+    pub g: Vector<D>,
+    /// The walls' no-slip images.
+    pub mirror: Mirror,
+}
+
+impl<W: Weight, const D: usize> Predictor<W, D> {
+    /// The Laplacian's terms of the fluid at the positions `x` (rⁿ) with lists `list`.
+    pub fn terms<'a>(
+        &'a self,
+        list: &'a NeighbourList,
+        x: &'a [Vector<D>],
+        fluid: usize,
+        domain: Domain<D>,
+        own: &MpsData<D>,
+    ) -> Terms<'a, W, D> {
+        let (plate, type1) = (own.plate, own.type1);
+        Terms { ops: &self.ops, mirror: &self.mirror, list, x, fluid, plate, type1, domain }
+    }
+}
+
+impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for Predictor<W, D> {
+    fn name(&self) -> &'static str {
+        "predictor"
+    }
+
+    fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
+        let (dt, nf, dom) = (ctx.dt, s.particles.fluid, s.domain);
+        let (nu, g) = (self.nu, self.g);
+        let periodic = dom.is_periodic();
+        let part = &mut s.particles;
+        let terms = self.terms(&s.neighbours, &part.x_old, nf, dom, own);
+        let (x_old, u_old, u, x) = (&part.x_old, &part.u_old, &mut part.u, &mut part.x);
+        u[..nf].par_iter_mut().zip(x[..nf].par_iter_mut()).enumerate().with_min_len(256).for_each(
+            |(i, (u, x))| {
+                let mut a = g;
+                if nu > 0.0 {
+                    a += terms.laplacian(i, u_old) * nu;
+                }
+                *u = u_old[i] + a * dt;
+                *x = x_old[i] + *u * dt;
+                if periodic {
+                    dom.wrap(x);
+                }
+            },
+        );
+        Ok(())
+    }
+}
+
 /// MPS.md step 1 with the viscous term backward Euler: `u* − Δt ν ⟨∇²u*⟩ = uⁿ + Δt g`, one
 /// sparse solve per velocity component with the same matrix, then `r* = rⁿ + Δt u*`. Not
 /// Lan's (explicit) step: it lifts the viscous limit `Δt ≤ α_d λ/(2dν)`, which binds the
@@ -112,14 +165,8 @@ impl<W: Weight, const D: usize> Terms<'_, W, D> {
 /// from uⁿ + Δt g. Plate particles move at U, a known value on the right-hand side.
 #[derive(Debug)]
 pub struct ImplicitPredictor<W: Weight, const D: usize> {
-    /// The operators.
-    pub ops: Operators<W, D>,
-    /// Kinematic viscosity ν \[m²/s\].
-    pub nu: f64,
-    /// Body force per unit mass \[m/s²\].
-    pub g: Vector<D>,
-    /// The walls' no-slip images.
-    pub mirror: Mirror,
+    /// The physics (operators, ν, g, wall images) of the explicit predictor.
+    pub physics: Predictor<W, D>,
     matrix: CsrMatrix,
     solver: LinearSolver,
     rhs: Vec<f64>,
@@ -127,17 +174,10 @@ pub struct ImplicitPredictor<W: Weight, const D: usize> {
 }
 
 impl<W: Weight, const D: usize> ImplicitPredictor<W, D> {
-    /// The stage for kinematic viscosity `nu` \[m²/s\] and body force `g` \[m/s²\].
-    pub fn new(ops: Operators<W, D>, nu: f64, g: Vector<D>, mirror: Mirror) -> Self {
-        let params = SolverParams {
-            method: Method::Cg,
-            tolerance: TOLERANCE,
-            max_iterations: 2000,
-            preconditioner: PreconditionerKind::Jacobi,
-            coarse_refresh: 1,
-        };
-        let solver = LinearSolver::new(params).measuring_residual(false);
-        Self { ops, nu, g, mirror, matrix: CsrMatrix::default(), solver, rhs: Vec::new(), x: Vec::new() }
+    /// The stage with the physics of `physics`.
+    pub fn new(physics: Predictor<W, D>) -> Self {
+        let solver = LinearSolver::new(SolverParams::viscous()).measuring_residual(false);
+        Self { physics, matrix: CsrMatrix::default(), solver, rhs: Vec::new(), x: Vec::new() }
     }
 }
 
@@ -148,18 +188,9 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for ImplicitPredictor<W, D>
 
     fn run(&mut self, s: &mut State<D>, own: &mut MpsData<D>, ctx: &StepContext) -> Result<(), Cause> {
         let (dt, nf) = (ctx.dt, s.particles.fluid);
-        let c = dt * self.nu;
+        let c = dt * self.physics.nu;
         let part = &mut s.particles;
-        let terms = Terms {
-            ops: &self.ops,
-            mirror: &self.mirror,
-            list: &s.neighbours,
-            x: &part.x_old,
-            fluid: nf,
-            plate: own.plate,
-            type1: own.type1,
-            domain: s.domain,
-        };
+        let terms = self.physics.terms(&s.neighbours, &part.x_old, nf, s.domain, own);
         // Off-diagonal entries: one per fluid term and per image of another particle.
         let m = &mut self.matrix;
         m.row_ptr.resize(nf + 1, 0);
@@ -203,7 +234,7 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for ImplicitPredictor<W, D>
         };
         par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut m.diag, &row);
         m.invert_diagonal();
-        let (u_old, g) = (&part.u_old, self.g);
+        let (u_old, g) = (&part.u_old, self.physics.g);
         for k in 0..D {
             self.rhs.resize(nf, 0.0);
             self.rhs.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
