@@ -169,6 +169,8 @@ pub struct ImplicitPredictor<W: Weight, const D: usize> {
     pub physics: Predictor<W, D>,
     matrix: CsrMatrix,
     solver: LinearSolver,
+    /// The right-hand side `uⁿ + Δt g` plus the plate's known terms, per fluid particle.
+    rhs_all: Vec<Vector<D>>,
     rhs: Vec<f64>,
     x: Vec<f64>,
 }
@@ -177,7 +179,14 @@ impl<W: Weight, const D: usize> ImplicitPredictor<W, D> {
     /// The stage with the physics of `physics`.
     pub fn new(physics: Predictor<W, D>) -> Self {
         let solver = LinearSolver::new(SolverParams::viscous()).measuring_residual(false);
-        Self { physics, matrix: CsrMatrix::default(), solver, rhs: Vec::new(), x: Vec::new() }
+        Self {
+            physics,
+            matrix: CsrMatrix::default(),
+            solver,
+            rhs_all: Vec::new(),
+            rhs: Vec::new(),
+            x: Vec::new(),
+        }
     }
 }
 
@@ -235,17 +244,20 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for ImplicitPredictor<W, D>
         par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut m.diag, &row);
         m.invert_diagonal();
         let (u_old, g) = (&part.u_old, self.physics.g);
-        for k in 0..D {
-            self.rhs.resize(nf, 0.0);
-            self.rhs.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
-                let mut known = 0.0;
-                terms.each(i, |t| {
-                    if let Term::Known(j, w) = t {
-                        known += stored(c * w) * u_old[j][k];
-                    }
-                });
-                *r = u_old[i][k] + dt * g[k] + known;
+        // The right-hand side of every component in one pass over the terms.
+        self.rhs_all.resize(nf, Vector::zeros());
+        self.rhs_all.par_iter_mut().enumerate().with_min_len(256).for_each(|(i, r)| {
+            let mut known = Vector::<D>::zeros();
+            terms.each(i, |t| {
+                if let Term::Known(j, w) = t {
+                    known += u_old[j] * stored(c * w);
+                }
             });
+            *r = u_old[i] + g * dt + known;
+        });
+        for k in 0..D {
+            self.rhs.clear();
+            self.rhs.extend(self.rhs_all.iter().map(|r| r[k]));
             self.x.clear();
             self.x.extend_from_slice(&self.rhs);
             self.solver.solve(&self.matrix, &self.rhs, &mut self.x, false).map_err(crate::ppe::cause)?;
