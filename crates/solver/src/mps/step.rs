@@ -138,8 +138,11 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for NumberDensity<W, D> {
 /// MPS.md step 3, Lan eq. 4 with Lee et al.'s mixed source, as `A P = b` with `A` symmetric
 /// positive definite: for every fluid and type-1 wall particle off the free surface,
 /// `Σ_j a_ij (P_i − P_j) + (ρ α/Δt²) P_i = −(1 − γ)(ρ/Δt)⟨∇·u*⟩_i + γ (ρ/Δt²)(n*_i − n0)/n0`,
-/// `a_ij = (2d/(λ n0)) w_ij`. Free-surface particles (P = 0) drop out; type-2 wall
-/// particles enter with their last extrapolated pressure, moved to the right-hand side.
+/// `a_ij = (2d/(λ n0)) w_ij`. Free-surface particles (P = 0) drop out. Type-2 wall
+/// particles are not in the sum (zero flux to them), as Koshizuka's sample code leaves its
+/// dummy walls out of the matrix: as known values at their extrapolated pressures they
+/// would be Dirichlet conditions a step behind (docs/notes/mps.md, the channel at Re 4).
+/// With no free surface the system is singular (grounded by the solver).
 #[derive(Debug)]
 pub struct PpeAssemble<W: Weight, const D: usize> {
     /// The operators.
@@ -172,10 +175,10 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
             }
         }
         let rows = sys.particle_of.len();
-        // Known pressures: the free surface (zero) and the type-2 walls; the
-        // quasi-compressibility's diagonal makes the system regular too.
-        sys.singular = rows == solved && total == solved && self.compressibility == 0.0;
-        let (u, p, list, pairs, ops) = (&s.particles.u, &s.particles.p, &s.neighbours, &s.pairs, &self.ops);
+        // Known pressures: the free surface (zero); the quasi-compressibility's diagonal
+        // makes the system regular too.
+        sys.singular = rows == solved && self.compressibility == 0.0;
+        let (u, list, pairs, ops) = (&s.particles.u, &s.neighbours, &s.pairs, &self.ops);
         let (row_of, particle_of, density) = (&sys.row_of, &sys.particle_of, &own.density);
         let m = &mut sys.matrix;
         m.row_ptr.resize(rows + 1, 0);
@@ -203,7 +206,7 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
         sys.row_out.resize(rows, [0.0; 2]);
         let row = |k: usize, cols: &mut [u32], vals: &mut [f32], out: &mut [f64; 2]| {
             let i = particle_of[k] as usize;
-            let (mut diag, mut known) = (compress, 0.0);
+            let mut diag = compress;
             // Σ (u_j − u_i) ⊗ r_ij w/r² (its trace times d/n0 is Lan's divergence) and the moment.
             let (mut grad_u, mut moment) = (Matrix::<D>::zeros(), Matrix::<D>::zeros());
             let mut e = 0;
@@ -222,12 +225,13 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
                 }
                 // Rounded as stored, here and in the diagonal (see `CsrMatrix`).
                 let c = stored(ops.laplacian_weight(r));
-                diag += c;
                 match row_of[j] {
-                    // Free-surface particles hold P = 0; type-2 walls their extrapolation.
-                    u32::MAX if j < solved => {}
-                    u32::MAX => known += c * p[j],
+                    // Free-surface particles hold P = 0.
+                    u32::MAX if j < solved => diag += c,
+                    // Type-2 walls are not in the Laplacian (zero flux).
+                    u32::MAX => {}
                     rj => {
+                        diag += c;
                         (cols[e], vals[e]) = (rj, -c as f32);
                         e += 1;
                     }
@@ -242,7 +246,7 @@ impl<W: Weight, const D: usize> Stage<D, MpsData<D>> for PpeAssemble<W, D> {
                 grad_u.trace()
             };
             let source = (1.0 - gamma) * rho / dt * div - gamma * rho / (dt * dt) * (density[i].n - n0) / n0;
-            *out = [diag, -source + known];
+            *out = [diag, -source];
         };
         par_csr_rows_mut(&m.row_ptr, &mut m.cols, &mut m.vals, &mut sys.row_out, &row);
         sys.finish_rows();

@@ -2,9 +2,11 @@
 //! behind each wall plane, deep enough to cover the Laplacian radius. Type 1, within the
 //! gradient radius of the first fluid layer, are unknowns of the PPE (their pressure
 //! pushes the fluid off the wall through the gradient); type 2, the outer layers, only
-//! complete the number density and the Laplacian of their neighbours, their pressure
-//! extrapolated after each solve ([`WallPressure`]). The no-slip viscous term does not use
-//! them: it mirrors the fluid across the plane ([`Mirror`], Lan Fig. 2).
+//! complete the number density of their neighbours (they are not in the PPE, as the dummy
+//! walls of Koshizuka's sample code), their pressure extrapolated after each solve
+//! ([`WallPressure`]) for the gradient of a fluid particle that comes within reach. The
+//! no-slip viscous term does not use them: it mirrors the fluid across the plane
+//! ([`Mirror`], Lan Fig. 2).
 
 use super::MpsData;
 use super::operators::Operators;
