@@ -385,7 +385,11 @@ impl<const D: usize> Simulation<D> {
 
     /// Δt of the next step, never past `remaining` (the time to the end or to the next
     /// requested probe time): the fixed step, or the scheme's stable step (Qiu eqs.
-    /// 17–19), which may not fall below 1e-9 of the end time.
+    /// 17–19), which may not fall below 1e-9 of the end time. A remainder between one and
+    /// two steps is split in halves, so that landing on a target never takes a step much
+    /// shorter than the others: the density terms of the projection schemes' sources
+    /// (ISPH's density relaxation, MPS's mixed source, both over Δt²) turn a sliver of a
+    /// step into a pressure spike (docs/notes/mps.md, the channel at Re 4).
     pub(crate) fn time_step(&self, remaining: f64) -> Result<f64, Cause> {
         let dt = match self.scene.time.step {
             TimeStep::Fixed(dt) => dt,
@@ -399,7 +403,13 @@ impl<const D: usize> Simulation<D> {
             }
         };
         // Never more than Δt; a remainder within rounding of Δt is taken whole.
-        Ok(if remaining <= dt * (1.0 + 1e-9) { remaining } else { dt })
+        Ok(if remaining <= dt * (1.0 + 1e-9) {
+            remaining
+        } else if remaining < 2.0 * dt {
+            0.5 * remaining
+        } else {
+            dt
+        })
     }
 
     /// The end-of-step guard at `time` after a step of `dt` \[s\] ([`Guard::check`]).

@@ -1,5 +1,6 @@
 //! `output.snapshot_times` and `bodies[i].jitter`: snapshots land on their times without
-//! changing the probes, and a jittered lattice is seeded and bounded.
+//! changing the probes, a step landing on a time is never a sliver, and a jittered lattice
+//! is seeded and bounded.
 
 mod common;
 
@@ -54,6 +55,24 @@ fn snapshots_land_on_their_times_and_leave_the_probes_alone() {
     let close = |a: f64, b: f64| (a - b).abs() <= 1e-14 * a.abs().max(1.0);
     assert!(back.p.iter().zip(&orig.p).all(|(a, b)| close(*a, *b)), "pressures survive JSON");
     assert!(back.x.iter().zip(&orig.x).all(|(a, b)| (0..3).all(|k| close(a[k], b[k]))));
+}
+
+#[test]
+fn a_remainder_between_one_and_two_steps_is_split_in_halves() {
+    // End at 2.5 Δt (Δt = 2e-5 s): Δt, then 0.75 Δt twice, not Δt, Δt and a 0.5 Δt sliver.
+    let r = meniscus::run(
+        &small(|v| {
+            v["time"]["end"] = json!(5e-5);
+            v["output"]["probe_every"] = json!(1);
+        }),
+        &mut meniscus::Quiet,
+    )
+    .unwrap();
+    assert!(r.error.is_none());
+    let t = &r.probes.t;
+    let expected = [0.0, 2e-5, 3.5e-5, 5e-5];
+    assert_eq!(t.len(), expected.len(), "{t:?}");
+    assert!(t.iter().zip(expected).all(|(a, b)| (a - b).abs() <= 1e-15), "{t:?}");
 }
 
 #[test]
