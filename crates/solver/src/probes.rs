@@ -30,6 +30,46 @@ impl ProbeRecord {
     }
 }
 
+/// Per-bin sums of a profile: Σ position, Σ velocity, count.
+type Bins = (Vec<f64>, Vec<f64>, Vec<usize>);
+
+/// Profile bins: the sums and the writing shared by the velocity profiles.
+mod profile_bins {
+    use super::{Bins, ProbeRecord};
+
+    /// Fills the profile scratch with `bins` bins from `(bin, position, velocity)` samples
+    /// (bins outside `0..bins` dropped): per bin Σ position, Σ velocity and the count.
+    pub(super) fn fill(scratch: &mut Bins, bins: usize, samples: impl Iterator<Item = (f64, f64, f64)>) {
+        let (sum_y, sum_u, count) = (&mut scratch.0, &mut scratch.1, &mut scratch.2);
+        for v in [&mut *sum_y, &mut *sum_u] {
+            v.clear();
+            v.resize(bins, 0.0);
+        }
+        count.clear();
+        count.resize(bins, 0);
+        for (k, y, u) in samples {
+            if k >= 0.0 && (k as usize) < bins {
+                let k = k as usize;
+                sum_y[k] += y;
+                sum_u[k] += u;
+                count[k] += 1;
+            }
+        }
+    }
+
+    /// Writes the binned profile as `{position}_###` (mean position) and `u_###` (mean
+    /// velocity), NaN for an empty bin.
+    pub(super) fn write(scratch: &Bins, out: &mut ProbeRecord, key: &str, position: &str) {
+        let (sum_y, sum_u, count) = (&scratch.0, &scratch.1, &scratch.2);
+        for k in 0..count.len() {
+            let c = count[k] as f64;
+            let (y, v) = if count[k] > 0 { (sum_y[k] / c, sum_u[k] / c) } else { (f64::NAN, f64::NAN) };
+            out.push(key, &format!("{position}_{k:03}"), y);
+            out.push(key, &format!("u_{k:03}"), v);
+        }
+    }
+}
+
 /// Kernel weight W(r) used by the Shepard average of `pressure_at`, with its support.
 pub struct Weight {
     /// W(r) \[1/m^D\].
@@ -52,7 +92,7 @@ pub struct ProbeSet<const D: usize> {
     /// Own neighbour search of the disorder probe (pairs closer than Δx).
     search: Option<(CellSearch<D>, NeighbourList)>,
     /// Scratch of the velocity profiles: per bin Σ position, Σ velocity, count.
-    bins: (Vec<f64>, Vec<f64>, Vec<usize>),
+    bins: Bins,
     /// Own neighbour search of the drop-shape probe (pairs closer than 2 Δx) and its
     /// union-find parents.
     clusters: Option<(CellSearch<D>, NeighbourList, Vec<u32>)>,
@@ -136,36 +176,36 @@ impl<const D: usize> ProbeSet<D> {
                     out.push(key, "close_fraction", close);
                 }
                 Probe::VelocityProfile { axis, component, range, bins, slab } => {
-                    let bins = &bins.unwrap_or(((range[1] - range[0]) / s.dx).round() as usize);
-                    let (sum_y, sum_u, count) = (&mut self.bins.0, &mut self.bins.1, &mut self.bins.2);
-                    for v in [&mut *sum_y, &mut *sum_u] {
-                        v.clear();
-                        v.resize(*bins, 0.0);
-                    }
-                    count.clear();
-                    count.resize(*bins, 0);
-                    let width = (range[1] - range[0]) / *bins as f64;
-                    for (p, v) in x.iter().zip(u) {
-                        if let Some(sl) = slab
-                            && !(sl.range[0] <= p[sl.axis] && p[sl.axis] <= sl.range[1])
-                        {
-                            continue;
-                        }
-                        let k = ((p[*axis] - range[0]) / width).floor();
-                        if k >= 0.0 && (k as usize) < *bins {
-                            let k = k as usize;
-                            sum_y[k] += p[*axis];
-                            sum_u[k] += v[*component];
-                            count[k] += 1;
-                        }
-                    }
-                    for k in 0..*bins {
-                        let c = count[k] as f64;
-                        let (y, v) =
-                            if count[k] > 0 { (sum_y[k] / c, sum_u[k] / c) } else { (f64::NAN, f64::NAN) };
-                        out.push(key, &format!("y_{k:03}"), y);
-                        out.push(key, &format!("u_{k:03}"), v);
-                    }
+                    let bins = bins.unwrap_or(((range[1] - range[0]) / s.dx).round() as usize);
+                    let width = (range[1] - range[0]) / bins as f64;
+                    let in_slab = |p: &Vector<D>| {
+                        slab.is_none_or(|sl| sl.range[0] <= p[sl.axis] && p[sl.axis] <= sl.range[1])
+                    };
+                    profile_bins::fill(
+                        &mut self.bins,
+                        bins,
+                        x.iter()
+                            .zip(u)
+                            .filter(|(p, _)| in_slab(p))
+                            .map(|(p, v)| (((p[*axis] - range[0]) / width).floor(), p[*axis], v[*component])),
+                    );
+                    profile_bins::write(&self.bins, out, key, "y");
+                }
+                Probe::RadialProfile { axis, center, radius, component, bins } => {
+                    let bins = bins.unwrap_or((radius / s.dx).round() as usize);
+                    let c = Vector::<D>::from_iterator(center.iter().copied());
+                    let width = radius / bins as f64;
+                    profile_bins::fill(
+                        &mut self.bins,
+                        bins,
+                        x.iter().zip(u).map(|(p, v)| {
+                            let mut r = p - c;
+                            r[*axis] = 0.0;
+                            let rho = r.norm();
+                            ((rho / width).floor(), rho, v[*component])
+                        }),
+                    );
+                    profile_bins::write(&self.bins, out, key, "r");
                 }
                 Probe::MassBalance {} => {
                     out.push(key, "mass", mass * nf as f64);

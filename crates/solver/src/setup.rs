@@ -1,6 +1,7 @@
 //! The particles of a scene at t = 0, as the particle schemes start from them: the bodies
 //! seeded on the lattice (or rings) and jittered, positions wrapped into periodic axes, the
-//! open boundaries' buffers, dummy wall layers; and the shared [`State`] around them.
+//! open boundaries' buffers, dummy wall particles (layers behind wall planes, and wall
+//! bodies); and the shared [`State`] around them.
 
 use crate::scene::{Scene, WallModel, seeding};
 use crate::stages::dummy::dummy_layers;
@@ -23,9 +24,11 @@ pub fn particle_state<const D: usize>(scene: &Scene, h: f64, support: f64) -> (S
         _ => None,
     };
     let buffer = particles.total() - particles.fluid;
-    if scene.boundaries.wall_model == WallModel::Dummy && !scene.boundaries.walls.is_empty() {
+    if scene.boundaries.wall_model == WallModel::Dummy && scene.has_walls() {
         let depth = 2.0 * scene.h();
-        for x in dummy_layers(&scene.boundaries.walls, &domain, &particles.x, scene.dx, depth) {
+        let planes = dummy_layers(&scene.boundaries.walls, &domain, &particles.x, scene.dx, depth);
+        let bodies = seeding::seed_walls::<D>(scene).into_iter().map(|(x, _)| x);
+        for x in planes.into_iter().chain(bodies) {
             particles.x.push(x);
             particles.u.push(Vector::zeros());
             particles.p.push(0.0);

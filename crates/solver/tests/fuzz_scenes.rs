@@ -352,6 +352,9 @@ fn estimate(scene: &Scene) -> f64 {
             meniscus::scene::Shape::Rectangle { min, max } | meniscus::scene::Shape::Box { min, max } => {
                 min.iter().zip(max).map(|(a, b)| b - a + scene.dx).product()
             }
+            meniscus::scene::Shape::Cylinder { radius, length, .. } => {
+                std::f64::consts::PI * (radius + scene.dx).powi(2) * (length + scene.dx)
+            }
         })
         .sum::<f64>()
         / scene.dx.powi(d)

@@ -288,7 +288,16 @@ fn malformed_scene_table() {
             v["bodies"][0]["shape"]["circle"]["center"] = json!([1e30, 0.0])
         }),
         ("bodies[0].role", "", |v| v["bodies"][0]["role"] = json!("solid")),
-        ("bodies[0].role", "not supported", |v| v["bodies"][0]["role"] = json!("wall")),
+        ("boundaries.wall_model", "must be dummy", |v| v["bodies"][0]["role"] = json!("wall")),
+        ("bodies[0].velocity", "at rest", |v| {
+            v["bodies"][0]["role"] = json!("wall");
+            v["boundaries"] = json!({"wall_model": "dummy"});
+        }),
+        ("bodies", "no fluid particle", |v| {
+            v["bodies"][0] =
+                json!({"role": "wall", "shape": {"circle": {"center": [0.0, 0.0], "radius": 1.0}}});
+            v["boundaries"] = json!({"wall_model": "dummy"});
+        }),
         ("bodies", "at least one", |v| v["bodies"] = json!([])),
         ("dx", "particles", |v| v["dx"] = json!(1e-9)),
         // Overlapping bodies: the later body is named.

@@ -142,7 +142,7 @@ fn build_stages<K: Kernel, const D: usize>(
     let mut stages: Vec<Box<dyn Stage<D, IsphData>>> =
         vec![Box::new(Reorder::new(kernel.support, domain, REORDER_EVERY)), Box::new(predictor::Advect)];
     let g = Vector::<D>::from_fn(|i, _| scene.body_force.get(i).copied().unwrap_or(0.0));
-    let walls = (!scene.boundaries.walls.is_empty()).then_some(scene.boundaries.wall_model);
+    let walls = scene.has_walls().then_some(scene.boundaries.wall_model);
     if walls == Some(WallModel::Mirror) {
         stages.push(Box::new(walls::Walls::new(&scene.boundaries.walls, kernel.support)));
     }

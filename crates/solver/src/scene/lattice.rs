@@ -53,6 +53,9 @@ pub fn lattice_points<const D: usize>(shape: &Shape, dx: f64) -> Vec<SVector<f64
             });
             out
         }
+        Shape::Cylinder { center, axis, radius, length, inner_radius } => {
+            cylinder_points::<D>(center, *axis, (*inner_radius, *radius, *length), dx, false)
+        }
     }
 }
 
@@ -62,19 +65,88 @@ pub fn lattice_points<const D: usize>(shape: &Shape, dx: f64) -> Vec<SVector<f64
 /// `k` has the area `2π r_k R/n`, so every particle stands for `(R/n)² (2π(k − ½)/m_k)`,
 /// within 5 % of `(R/n)²` for `k ≥ 2` (the inner ring's 3 particles cover `π (R/n)²`).
 fn ring_points<const D: usize>(center: &[f64], radius: f64, dx: f64) -> Vec<SVector<f64, D>> {
-    let n = ((radius / dx).round() as usize).max(1);
-    let spacing = radius / n as f64;
-    let mut out = Vec::new();
-    for k in 1..=n {
+    let c = SVector::<f64, D>::from_iterator(center.iter().copied());
+    rings(0.0, radius, dx).map(|(r, theta)| c + ring_offset::<D>(r, theta, 0, 1)).collect()
+}
+
+/// The rings of the annulus `inner < ρ <= outer` as `(radius, angle)` pairs: with
+/// `inner = 0` those of [`ring_points`] (spacing `s = R/round(R/Δx)`); with `inner > 0` the
+/// rings of a disc of radius `inner` continued outward (`s = inner/round(inner/Δx)`, rings
+/// `k > inner/s` while `(k − ½) s <= outer`), so a shell meets the disc it surrounds.
+fn rings(inner: f64, outer: f64, dx: f64) -> impl Iterator<Item = (f64, f64)> {
+    let base = if inner > 0.0 { inner } else { outer };
+    let n = ((base / dx).round() as usize).max(1);
+    let spacing = base / n as f64;
+    let first = if inner > 0.0 { n + 1 } else { 1 };
+    let last = if inner > 0.0 { (outer * (1.0 + EDGE_TOL) / spacing + 0.5).floor() as usize } else { n };
+    (first..=last).flat_map(move |k| {
         let ring = k as f64 - 0.5;
         let m = (2.0 * std::f64::consts::PI * ring).round() as usize;
-        for j in 0..m {
-            let theta = 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / m as f64;
-            let (s, c) = theta.sin_cos();
-            out.push(SVector::<f64, D>::from_fn(|i, _| {
-                center[i] + ring * spacing * if i == 0 { c } else { s }
-            }));
+        (0..m).map(move |j| (ring * spacing, 2.0 * std::f64::consts::PI * (j as f64 + 0.5) / m as f64))
+    })
+}
+
+/// The offset `r (cos θ e_a + sin θ e_b)` in the plane of axes `a` and `b`.
+fn ring_offset<const D: usize>(r: f64, theta: f64, a: usize, b: usize) -> SVector<f64, D> {
+    let (s, c) = theta.sin_cos();
+    SVector::<f64, D>::from_fn(|i, _| {
+        if i == a {
+            r * c
+        } else if i == b {
+            r * s
+        } else {
+            0.0
         }
+    })
+}
+
+/// The two axes across a cylinder along `axis`, in increasing order.
+fn cross_axes(axis: usize) -> (usize, usize) {
+    match axis {
+        0 => (1, 2),
+        1 => (0, 2),
+        _ => (0, 1),
+    }
+}
+
+/// The points of a cylinder (or shell) along `axis`: `count = floor(length/Δx)` layers at
+/// `c + (i − (count − 1)/2) Δx` along the axis (cell-centred and symmetric, as a box), each
+/// layer the cross-section's rings (`rings` true) or its lattice points `(i + ½) Δx` about the
+/// centre with `inner < ρ <= radius`.
+fn cylinder_points<const D: usize>(
+    center: &[f64],
+    axis: usize,
+    (inner, radius, length): (f64, f64, f64),
+    dx: f64,
+    rings_packing: bool,
+) -> Vec<SVector<f64, D>> {
+    let c = SVector::<f64, D>::from_iterator(center.iter().copied());
+    let (a, b) = cross_axes(axis);
+    let section: Vec<SVector<f64, D>> = if rings_packing {
+        rings(inner, radius, dx).map(|(r, theta)| ring_offset::<D>(r, theta, a, b)).collect()
+    } else {
+        let n = (radius / dx).ceil() as i64 + 1;
+        let (lo2, hi2) = (inner * inner * (1.0 + EDGE_TOL), radius * radius * (1.0 + EDGE_TOL));
+        let mut out = Vec::new();
+        for i in -n - 1..=n {
+            for j in -n - 1..=n {
+                let (p, q) = ((i as f64 + 0.5) * dx, (j as f64 + 0.5) * dx);
+                let rho2 = p * p + q * q;
+                if rho2 <= hi2 && (inner == 0.0 || rho2 > lo2) {
+                    let mut x = SVector::<f64, D>::zeros();
+                    (x[a], x[b]) = (p, q);
+                    out.push(x);
+                }
+            }
+        }
+        out
+    };
+    let count = ((length / dx + EDGE_TOL).floor() as i64).max(1);
+    let mut out = Vec::with_capacity(section.len() * count as usize);
+    for i in 0..count {
+        let mut along = SVector::<f64, D>::zeros();
+        along[axis] = (i as f64 - 0.5 * (count - 1) as f64) * dx;
+        out.extend(section.iter().map(|s| c + along + s));
     }
     out
 }
@@ -102,11 +174,18 @@ pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector
             density * g.dot(&(x - s))
         }
     };
-    let points = match (body.packing, &body.shape) {
+    seed_points::<D>(body, dx).into_iter().map(|x| Seed { x, u: velocity(&x), p: pressure(&x) }).collect()
+}
+
+/// The points of a body at spacing `dx`: its packing (rings) or the lattice.
+pub fn seed_points<const D: usize>(body: &Body, dx: f64) -> Vec<SVector<f64, D>> {
+    match (body.packing, &body.shape) {
         (Packing::Rings, Shape::Circle { center, radius }) => ring_points::<D>(center, *radius, dx),
+        (Packing::Rings, Shape::Cylinder { center, axis, radius, length, inner_radius }) => {
+            cylinder_points::<D>(center, *axis, (*inner_radius, *radius, *length), dx, true)
+        }
         _ => lattice_points::<D>(&body.shape, dx),
-    };
-    points.into_iter().map(|x| Seed { x, u: velocity(&x), p: pressure(&x) }).collect()
+    }
 }
 
 /// Displaces every point by a vector uniform in the ball of radius `jitter.fraction · dx`
@@ -228,6 +307,52 @@ mod tests {
         let before = b.clone();
         apply_jitter(&mut b, dx, &Jitter { fraction: 0.1, seed: 1 });
         assert!(b.iter().zip(&before).all(|(p, q)| (p - q).norm() <= 0.1 * dx + 1e-15));
+    }
+
+    fn cylinder(radius: f64, inner_radius: f64, packing: Packing) -> Body {
+        let shape =
+            Shape::Cylinder { center: vec![0.5, 0.0, 0.0], axis: 0, radius, length: 0.1, inner_radius };
+        Body {
+            role: super::super::schema::Role::Fluid,
+            shape,
+            velocity: InitialVelocity::Zero,
+            pressure: InitialPressure::Zero,
+            jitter: None,
+            packing,
+        }
+    }
+
+    #[test]
+    fn a_ringed_pipe_wall_continues_its_fluid_rings() {
+        let (r, dx) = (0.08, 0.01);
+        let fluid = seed_points::<3>(&cylinder(r, 0.0, Packing::Rings), dx);
+        let wall = seed_points::<3>(&cylinder(r + 0.025, r, Packing::Rings), dx);
+        // 10 layers along x at 0.455 … 0.545; Σ_k round(2π (k − ½)) over k = 1..8 = 201 per
+        // layer; the shell's rings k = 9, 10, 11 at 8.5, 9.5, 10.5 dx (≤ 10.5 dx): 53 + 60 + 66.
+        assert_eq!(fluid.len(), 201 * 10);
+        assert_eq!(wall.len(), (53 + 60 + 66) * 10);
+        let rho = |x: &SVector<f64, 3>| x.y.hypot(x.z);
+        let outer = fluid.iter().map(rho).fold(0.0, f64::max);
+        let inner = wall.iter().map(rho).fold(f64::INFINITY, f64::min);
+        assert!((outer - 7.5 * dx).abs() < 1e-12 && (inner - 8.5 * dx).abs() < 1e-12, "{outer} {inner}");
+        let xs: Vec<f64> = fluid.iter().map(|x| x.x).collect();
+        assert!((xs.iter().cloned().fold(f64::INFINITY, f64::min) - 0.455).abs() < 1e-12);
+        // No wall particle closer than 0.8 dx to a fluid particle.
+        for w in &wall {
+            assert!(fluid.iter().all(|f| (w - f).norm() > 0.8 * dx), "{w}");
+        }
+    }
+
+    #[test]
+    fn a_lattice_shell_and_its_cylinder_share_no_point() {
+        let dx = 0.01;
+        let fluid = seed_points::<3>(&cylinder(0.05, 0.0, Packing::Lattice), dx);
+        let wall = seed_points::<3>(&cylinder(0.08, 0.05, Packing::Lattice), dx);
+        let solid = seed_points::<3>(&cylinder(0.08, 0.0, Packing::Lattice), dx);
+        assert_eq!(fluid.len() + wall.len(), solid.len(), "the shell is the solid cylinder minus the fluid");
+        for w in &wall {
+            assert!(fluid.iter().all(|f| (w - f).norm() > 0.99 * dx));
+        }
     }
 
     #[test]

@@ -51,4 +51,10 @@ impl Scene {
     pub fn h(&self) -> f64 {
         self.kernel.h_over_dx * self.dx
     }
+
+    /// Whether the scene has walls: `boundaries.walls` planes or wall bodies (`role: wall`,
+    /// always dummy particles).
+    pub fn has_walls(&self) -> bool {
+        !self.boundaries.walls.is_empty() || self.bodies.iter().any(|b| b.role == Role::Wall)
+    }
 }

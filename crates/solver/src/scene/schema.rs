@@ -133,11 +133,14 @@ pub enum Packing {
     /// The cell-centred lattice `x = c + (i + ½) Δx` (DESIGN.md "Meaning").
     #[default]
     Lattice,
-    /// Concentric rings (a 2D circle only): ring `k = 1..n`, `n = round(R/Δx)`, at radius
-    /// `r_k = (k − ½) R/n` with `round(2π r_k n/R)` equally spaced particles, so each
-    /// particle stands for about `Δx²` of the annulus and the outer ring is a smooth
-    /// circle half a spacing inside `R`: a drop whose surface has no lattice steps (the
-    /// steps of a lattice circle carry a curvature noise of O(1/Δx)).
+    /// Concentric rings (a 2D circle, or the cross-section of a 3D cylinder stacked at Δx
+    /// along its axis): ring `k = 1..n`, `n = round(R/Δx)`, at radius `r_k = (k − ½) R/n`
+    /// with `round(2π r_k n/R)` equally spaced particles, so each particle stands for about
+    /// `Δx²` of the annulus and the outer ring is a smooth circle half a spacing inside `R`:
+    /// a drop (or a pipe's fluid) whose surface has no lattice steps (the steps of a
+    /// lattice circle carry a curvature noise of O(1/Δx)). A shell (`inner_radius` > 0)
+    /// continues the rings of a disc of radius `inner_radius` outward (spacing
+    /// `inner_radius / round(inner_radius/Δx)`), so a pipe wall meets its fluid's rings.
     Rings,
 }
 
@@ -204,6 +207,29 @@ pub enum Shape {
         /// Radius \[m\].
         radius: f64,
     },
+    /// Circular cylinder (3D) along `axis`: the points whose distance ρ from the axis line
+    /// through `center` is at most `radius` and whose coordinate along `axis` lies within
+    /// `length / 2` of the centre's. With `inner_radius` > 0 a cylindrical shell
+    /// (`inner_radius < ρ <= radius`): the wall body of a pipe around a fluid cylinder of
+    /// radius `inner_radius`.
+    Cylinder {
+        /// Centre of the cylinder (the middle of its axis) \[m\].
+        center: Vec<f64>,
+        /// The axis the cylinder runs along (0, 1 or 2).
+        axis: usize,
+        /// Outer radius \[m\].
+        radius: f64,
+        /// Length along `axis` \[m\].
+        length: f64,
+        /// Inner radius of a shell \[m\] (0, a solid cylinder, if absent).
+        #[serde(default, skip_serializing_if = "is_zero")]
+        inner_radius: f64,
+    },
+}
+
+/// Whether a length is zero (an omitted optional length).
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// Initial velocity field.
@@ -861,6 +887,23 @@ pub enum Probe {
         #[serde(default)]
         slab: Option<Slab>,
     },
+    /// Velocity profile across a pipe (3D): the fluid within `radius` of the axis line
+    /// through `center` along `axis` is split into equal bins of the distance ρ from that
+    /// line; each bin records the mean distance `r_###` \[m\] and the mean velocity
+    /// component `u_###` \[m/s\] of its particles (NaN when empty).
+    RadialProfile {
+        /// The pipe's axis (0 = x).
+        axis: usize,
+        /// A point of the axis line \[m\].
+        center: Vec<f64>,
+        /// Outer edge of the last bin \[m\] (the pipe's radius).
+        radius: f64,
+        /// Velocity component recorded (0 = u_x, the flow along a pipe on x).
+        component: usize,
+        /// Number of bins (1–999); absent: one per Δx, `round(radius / Δx)`.
+        #[serde(default)]
+        bins: Option<usize>,
+    },
 }
 
 /// A slab `range[0] <= x[axis] <= range[1]`.
@@ -936,6 +979,7 @@ impl Probe {
             Probe::Disorder {} => "disorder",
             Probe::Solver {} => "solver",
             Probe::VelocityProfile { .. } => "velocity_profile",
+            Probe::RadialProfile { .. } => "radial_profile",
             Probe::MassBalance {} => "mass_balance",
             Probe::MaxSpeed {} => "max_speed",
             Probe::DropShape {} => "drop_shape",

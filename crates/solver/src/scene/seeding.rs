@@ -3,7 +3,7 @@
 //! wrapped into the periodic axes, then jittered where a body asks for it.
 
 use super::lattice;
-use super::schema::Scene;
+use super::schema::{Role, Scene};
 use crate::neighbours::Domain;
 use nalgebra::SVector;
 
@@ -36,14 +36,17 @@ pub fn domain<const D: usize>(scene: &Scene) -> Domain<D> {
     domain
 }
 
-/// Every body of `scene` seeded (lattice or rings) and wrapped into the periodic axes, not
-/// yet jittered.
+/// Every fluid body of `scene` seeded (lattice or rings) and wrapped into the periodic axes,
+/// not yet jittered. A wall body holds no fluid: its range in `body_start` is empty.
 pub fn seed_bodies<const D: usize>(scene: &Scene) -> Seeds<D> {
     let g = SVector::<f64, D>::from_fn(|i, _| scene.body_force.get(i).copied().unwrap_or(0.0));
     let domain = domain::<D>(scene);
     let mut seeds = Seeds::<D>::default();
     for body in &scene.bodies {
         seeds.body_start.push(seeds.x.len());
+        if body.role == Role::Wall {
+            continue;
+        }
         for seed in lattice::seed_body::<D>(body, scene.dx, scene.fluid.density, &g) {
             let mut x = seed.x;
             domain.wrap(&mut x);
@@ -53,6 +56,22 @@ pub fn seed_bodies<const D: usize>(scene: &Scene) -> Seeds<D> {
         }
     }
     seeds
+}
+
+/// The particles of the wall bodies (`role: wall`), in body order, wrapped into the
+/// periodic axes: the dummy wall particles (Adami, Hu & Adams 2012) of a wall of any shape.
+/// With each particle, the index of its body.
+pub fn seed_walls<const D: usize>(scene: &Scene) -> Vec<(SVector<f64, D>, usize)> {
+    let domain = domain::<D>(scene);
+    let mut out = Vec::new();
+    for (i, body) in scene.bodies.iter().enumerate().filter(|(_, b)| b.role == Role::Wall) {
+        for x in lattice::seed_points::<D>(body, scene.dx) {
+            let mut x = x;
+            domain.wrap(&mut x);
+            out.push((x, i));
+        }
+    }
+    out
 }
 
 /// Applies each body's `jitter` (if any) to its particles and wraps them again.

@@ -186,6 +186,13 @@ fn shape_span(shape: &Shape, axis: usize) -> f64 {
         Shape::Rectangle { min, max } | Shape::Box { min, max } => {
             max.get(axis).copied().unwrap_or(0.0) - min.get(axis).copied().unwrap_or(0.0)
         }
+        Shape::Cylinder { axis: along, radius, length, .. } => {
+            if axis == *along {
+                *length
+            } else {
+                2.0 * radius
+            }
+        }
     }
 }
 
@@ -214,6 +221,9 @@ fn shape_measure(shape: &Shape) -> f64 {
         Shape::Sphere { radius, .. } => 4.0 / 3.0 * std::f64::consts::PI * radius.powi(3),
         Shape::Rectangle { min, max } | Shape::Box { min, max } => {
             min.iter().zip(max).map(|(a, b)| (b - a).max(0.0)).product()
+        }
+        Shape::Cylinder { radius, length, inner_radius, .. } => {
+            std::f64::consts::PI * (radius * radius - inner_radius * inner_radius) * length
         }
     }
 }
@@ -310,6 +320,13 @@ fn validate_mps(o: &MpsOptions, scene: &Scene) -> Result<(), SceneError> {
             "fluid.surface_tension",
             scene.fluid.surface_tension,
             "must be 0 with the mps scheme (it has no surface-tension model)",
+        ));
+    }
+    if let Some(i) = scene.bodies.iter().position(|b| b.role == Role::Wall) {
+        return Err(SceneError::new(
+            format!("bodies[{i}].role"),
+            "wall",
+            "is not an mps wall: the mps scheme lays its own wall particles behind `boundaries.walls` planes (MPS.md)",
         ));
     }
     if scene.boundaries.wall_model == WallModel::Dummy && !scene.boundaries.walls.is_empty() {
@@ -439,6 +456,55 @@ fn validate_body(f: &str, body: &Body, d: usize, dx: f64) -> Result<(), SceneErr
                         "holds no particle (max − min must be at least dx)",
                     ));
                 }
+            }
+        }
+        Shape::Cylinder { center, axis: along, radius, length, inner_radius } => {
+            let f = format!("{f}.shape.cylinder");
+            if d != 3 {
+                return Err(SceneError::new(&f, "cylinder", format!("is a 3D shape but the scene is {d}D")));
+            }
+            vector(&format!("{f}.center"), center, d)?;
+            near_origin(&format!("{f}.center"), center, dx)?;
+            if *along >= d {
+                return Err(SceneError::new(
+                    format!("{f}.axis"),
+                    along,
+                    "must be an axis of the scene (0..dimension)",
+                ));
+            }
+            positive(&format!("{f}.radius"), *radius)?;
+            positive(&format!("{f}.length"), *length)?;
+            for (name, v) in [("radius", *radius), ("length", *length)] {
+                if v > MAX_COORDINATE_OVER_DX * dx {
+                    return Err(SceneError::new(
+                        format!("{f}.{name}"),
+                        v,
+                        "must be at most 1e9 dx (double precision cannot resolve the particle spacing)",
+                    ));
+                }
+            }
+            if *length < dx * (1.0 - 1e-9) {
+                return Err(SceneError::new(
+                    format!("{f}.length"),
+                    length,
+                    "holds no particle (must be at least dx)",
+                ));
+            }
+            if !(inner_radius.is_finite() && *inner_radius >= 0.0) {
+                return Err(SceneError::new(
+                    format!("{f}.inner_radius"),
+                    inner_radius,
+                    "must be finite and not negative",
+                ));
+            }
+            if *radius - *inner_radius < 0.5 * dx {
+                return Err(SceneError::new(
+                    format!("{f}.radius"),
+                    radius,
+                    format!(
+                        "holds no particle (must exceed inner_radius = {inner_radius:e} m by at least dx/2)"
+                    ),
+                ));
             }
         }
     }

@@ -5,8 +5,8 @@
 use super::schema::*;
 use crate::error::SceneError;
 
-/// Checks `boundaries.walls`, `boundaries.inflow`/`outflow`, the `velocity_profile`
-/// probes, `output.probe_times`, `output.snapshot_times` and the bodies' `jitter` and `packing`.
+/// Checks `boundaries.walls`, `boundaries.inflow`/`outflow`, the `velocity_profile` and
+/// `radial_profile` probes, `output.probe_times`, `output.snapshot_times` and the bodies' `jitter` and `packing`.
 pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
     let d = scene.dimension;
     open_boundaries(scene)?;
@@ -40,6 +40,41 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
             if let Some(slab) = slab {
                 axis(&format!("{f}.slab.axis"), slab.axis, d)?;
                 ordered(&format!("{f}.slab.range"), &slab.range)?;
+            }
+        }
+        if let Probe::RadialProfile { axis: a, center, radius, component, bins } = probe {
+            let f = format!("probes[{i}].radial_profile");
+            if d != 3 {
+                return Err(SceneError::new(
+                    f,
+                    "radial_profile",
+                    format!("is a 3D probe but the scene is {d}D"),
+                ));
+            }
+            axis(&format!("{f}.axis"), *a, d)?;
+            axis(&format!("{f}.component"), *component, d)?;
+            if center.len() != d {
+                return Err(SceneError::new(
+                    format!("{f}.center"),
+                    format!("{} components", center.len()),
+                    format!("must have {d} components"),
+                ));
+            }
+            for (k, c) in center.iter().enumerate() {
+                finite(&format!("{f}.center[{k}]"), *c)?;
+            }
+            finite(&format!("{f}.radius"), *radius)?;
+            if *radius <= 0.0 {
+                return Err(SceneError::new(format!("{f}.radius"), radius, "must be positive"));
+            }
+            let n = bins.unwrap_or((radius / scene.dx).round() as usize);
+            if !(1..=999).contains(&n) {
+                let rule = if bins.is_some() {
+                    "must be between 1 and 999"
+                } else {
+                    "(one per Δx) must be between 1 and 999"
+                };
+                return Err(SceneError::new(format!("{f}.bins"), n, rule));
             }
         }
     }
@@ -76,11 +111,12 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
         }
     }
     for (i, body) in scene.bodies.iter().enumerate() {
-        if body.packing == Packing::Rings && !(d == 2 && matches!(body.shape, Shape::Circle { .. })) {
+        let ringed = matches!((d, &body.shape), (2, Shape::Circle { .. }) | (3, Shape::Cylinder { .. }));
+        if body.packing == Packing::Rings && !ringed {
             return Err(SceneError::new(
                 format!("bodies[{i}].packing"),
                 "rings",
-                "needs a circle in a 2D scene (concentric rings fill a disc)",
+                "needs a circle in a 2D scene or a cylinder in a 3D scene (concentric rings fill a disc)",
             ));
         }
         if let Some(j) = &body.jitter {
@@ -163,7 +199,7 @@ fn open_boundaries(scene: &Scene) -> Result<(), SceneError> {
             "is also the normal of a wall (walls must run along the flow)",
         ));
     }
-    if b.wall_model == WallModel::Dummy && !b.walls.is_empty() {
+    if b.wall_model == WallModel::Dummy && scene.has_walls() {
         return Err(SceneError::new(
             "boundaries.wall_model",
             "dummy",

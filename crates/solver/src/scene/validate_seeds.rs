@@ -3,7 +3,7 @@
 //! open boundaries must border the fluid. Checked by [`super::validate()`] on the particles
 //! the set-up will start from ([`super::seeding`]), so a scene that validates builds.
 
-use super::schema::{Role, Scene, Side};
+use super::schema::{InitialPressure, InitialVelocity, Role, Scene, Shape, Side, WallModel};
 use super::seeding::{self, Seeds};
 use crate::error::SceneError;
 use crate::neighbours::Domain;
@@ -19,17 +19,12 @@ pub fn validate_seeds(scene: &Scene) -> Result<(), SceneError> {
 }
 
 fn check<const D: usize>(scene: &Scene) -> Result<(), SceneError> {
-    if let Some(i) = scene.bodies.iter().position(|b| b.role == Role::Wall) {
-        return Err(SceneError::new(
-            format!("bodies[{i}].role"),
-            "wall",
-            "wall bodies are not supported yet (walls are `boundaries.walls` planes)",
-        ));
-    }
+    wall_bodies(scene)?;
     let mut seeds = seeding::seed_bodies::<D>(scene);
     if seeds.x.is_empty() {
-        return Err(SceneError::new("bodies", scene.bodies.len(), "hold no particle"));
+        return Err(SceneError::new("bodies", scene.bodies.len(), "hold no fluid particle"));
     }
+    walls_clear_of_fluid(scene, &seeds.x)?;
     for (i, wall) in scene.boundaries.walls.iter().enumerate() {
         let side = if wall.fluid_side == Side::Above { 1.0 } else { -1.0 };
         if let Some(x) = seeds.x.iter().find(|x| side * (x[wall.axis] - wall.position) <= 0.0) {
@@ -64,6 +59,93 @@ fn check<const D: usize>(scene: &Scene) -> Result<(), SceneError> {
                 format!("must lie within Δx downstream of the fluid's last particles (at {hi:.6e})"),
             ));
         }
+    }
+    Ok(())
+}
+
+/// The rules of wall bodies (`role: wall`): dummy particles at rest, so `wall_model` must
+/// be `dummy` and the body has no initial velocity, pressure or jitter; and a cylinder
+/// (a pipe's fluid, or the inside of its wall shell) wider than the kernel support.
+fn wall_bodies(scene: &Scene) -> Result<(), SceneError> {
+    let support = 2.0 * scene.h();
+    for (i, body) in scene.bodies.iter().enumerate() {
+        if let Shape::Cylinder { radius, inner_radius, .. } = body.shape {
+            let (name, r) =
+                if body.role == Role::Wall { ("inner_radius", inner_radius) } else { ("radius", radius) };
+            if r > 0.0 && r <= support {
+                return Err(SceneError::new(
+                    format!("bodies[{i}].shape.cylinder.{name}"),
+                    r,
+                    format!(
+                        "must exceed the kernel support 2h = {support:e} m (a pipe this narrow has no interior)"
+                    ),
+                ));
+            }
+        }
+        if body.role != Role::Wall {
+            continue;
+        }
+        if scene.boundaries.wall_model != WallModel::Dummy {
+            return Err(SceneError::new(
+                "boundaries.wall_model",
+                "mirror",
+                format!(
+                    "must be dummy: bodies[{i}] is a wall body, whose particles are dummy particles (Adami 2012)"
+                ),
+            ));
+        }
+        if body.velocity != InitialVelocity::Zero {
+            return Err(SceneError::new(
+                format!("bodies[{i}].velocity"),
+                "affine",
+                "must be absent: walls are at rest",
+            ));
+        }
+        if body.pressure != InitialPressure::Zero {
+            return Err(SceneError::new(
+                format!("bodies[{i}].pressure"),
+                "set",
+                "must be absent: a wall's pressure is extrapolated from the fluid every step",
+            ));
+        }
+        if body.jitter.is_some() {
+            return Err(SceneError::new(
+                format!("bodies[{i}].jitter"),
+                "set",
+                "must be absent on a wall body",
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Rejects a wall body whose particles come closer than Δx/2 to a fluid particle (`fluid`,
+/// seeded and wrapped, not jittered): a wall that overlaps the fluid.
+fn walls_clear_of_fluid<const D: usize>(scene: &Scene, fluid: &[Vector<D>]) -> Result<(), SceneError> {
+    let walls = seeding::seed_walls::<D>(scene);
+    if walls.is_empty() {
+        return Ok(());
+    }
+    let all: Vec<Vector<D>> = fluid.iter().copied().chain(walls.iter().map(|w| w.0)).collect();
+    let mut list = crate::neighbours::NeighbourList::default();
+    crate::neighbours::CellSearch::new(0.5 * scene.dx, seeding::domain::<D>(scene)).build_rows(
+        &all,
+        fluid.len(),
+        &mut list,
+    );
+    let hit = (0..fluid.len())
+        .find_map(|a| list.of(a).iter().find(|&&b| b as usize >= fluid.len()).map(|&b| (a, b)));
+    if let Some((a, b)) = hit {
+        let (x, body) = walls[b as usize - fluid.len()];
+        let show = |v: &Vector<D>| v.iter().map(|c| format!("{c:.4e}")).collect::<Vec<_>>().join(", ");
+        return Err(SceneError::new(
+            format!("bodies[{body}].shape"),
+            format!("a wall particle at ({})", show(&x)),
+            format!(
+                "overlaps the fluid (within dx/2 of the fluid particle at ({})); a wall body must lie outside the fluid",
+                show(&fluid[a])
+            ),
+        ));
     }
     Ok(())
 }

@@ -140,7 +140,7 @@ fn build_stages<K: Kernel, const D: usize>(
         delta: opts.density_diffusion.unwrap_or(0.0),
         g,
     };
-    let walls = (!scene.boundaries.walls.is_empty()).then_some(scene.boundaries.wall_model);
+    let walls = scene.has_walls().then_some(scene.boundaries.wall_model);
     // Boundaries and neighbours at the current positions.
     // `div_r`: the neighbours stage also sums `div r` (for the shifting's free-surface flags).
     let boundaries = |div_r: bool| {
