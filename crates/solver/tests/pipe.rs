@@ -42,7 +42,7 @@ fn pipe(n: usize, scheme: Value, tau_end: f64) -> Value {
 fn isph() -> Value {
     json!({ "isph": { "ppe": { "solver": "bicgstab", "tolerance": 1e-3, "max_iterations": 2000,
                                "preconditioner": "two_level" },
-                      "free_surface_threshold": 2.25, "shifting": { "xu": { "coefficient": 0.02 } } } })
+                      "shifting": { "xu": { "coefficient": 0.02 } } } })
 }
 
 fn wcsph() -> Value {

@@ -163,7 +163,7 @@ fn build_stages<K: Kernel, const D: usize>(
     if walls.is_some() || open.is_some() {
         stages.push(Box::new(BoundaryLinks));
     }
-    stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold }));
+    stages.push(Box::new(FreeSurface { threshold: opts.free_surface_threshold(D) }));
     // Explicit: u* = uⁿ + Δt ν L(uⁿ), then + Δt g. Implicit: uⁿ + Δt g first, then the
     // solve (the force inside it keeps the steady state exact).
     let nu = scene.fluid.viscosity / scene.fluid.density;
@@ -222,7 +222,7 @@ fn build_stages<K: Kernel, const D: usize>(
     stages.push(Box::new(projection::Correction { form: opts.pressure_gradient }));
     stages.push(Box::new(projection::Position));
     if let Some(law) = shifting::Law::of(opts.shifting) {
-        let shift = shifting::Shifting::new(law, kernel, opts.free_surface_threshold);
+        let shift = shifting::Shifting::new(law, kernel, opts.free_surface_threshold(D));
         stages.push(Box::new(if corrected { shift.reading_moments() } else { shift }));
     }
     if let Some(o) = open {

@@ -594,8 +594,12 @@ pub struct ArtificialViscosity {
 pub struct IsphOptions {
     /// Pressure Poisson solver.
     pub ppe: PpeOptions,
-    /// Free-surface threshold on `div r` (Qiu eq. 16 corrected; 1.5 in 2D).
-    pub free_surface_threshold: f64,
+    /// Free-surface threshold on `div r` (Qiu eq. 16 corrected): a particle with
+    /// `div r` below it is on the free surface. Default `D − ½`: 1.5 in 2D (Qiu), 2.5 in
+    /// 3D (`div r` is about D in the bulk and about D − 1 on a flat surface; public 3D codes
+    /// use 2.25–2.75; WCSPH's and MPS's shifting use the same `D − ½`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub free_surface_threshold: Option<f64>,
     /// Particle shifting (none if absent).
     #[serde(default)]
     pub shifting: Shifting,
@@ -617,6 +621,13 @@ pub struct IsphOptions {
     /// Discrete operator of the viscous term.
     #[serde(default)]
     pub viscous_operator: ViscousOperator,
+}
+
+impl IsphOptions {
+    /// The free-surface threshold in a `d`-dimensional scene: the scene's, else `d − ½`.
+    pub fn free_surface_threshold(&self, d: usize) -> f64 {
+        self.free_surface_threshold.unwrap_or(d as f64 - 0.5)
+    }
 }
 
 /// Discrete viscous operator of the ISPH predictor (Qiu 2013 eq. 4).
@@ -989,7 +1000,19 @@ impl Probe {
 
 #[cfg(test)]
 mod tests {
-    use super::ViscousOperator;
+    use super::{IsphOptions, ViscousOperator};
+
+    /// An absent free-surface threshold is `D − ½`; a given one is kept.
+    #[test]
+    fn the_free_surface_threshold_defaults_to_d_minus_a_half() {
+        let o: IsphOptions = serde_json::from_value(
+            serde_json::json!({"ppe": {"solver": "cg", "tolerance": 1e-3, "max_iterations": 100}}),
+        )
+        .expect("options without a threshold");
+        assert_eq!((o.free_surface_threshold(2), o.free_surface_threshold(3)), (1.5, 2.5));
+        let o = IsphOptions { free_surface_threshold: Some(2.25), ..o };
+        assert_eq!(o.free_surface_threshold(3), 2.25);
+    }
 
     /// Error messages name an operator as the scene file spells it.
     #[test]

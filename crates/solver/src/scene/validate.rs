@@ -230,7 +230,7 @@ fn shape_measure(shape: &Shape) -> f64 {
 
 fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
     validate_ppe("scheme.isph.ppe", &o.ppe)?;
-    let t = o.free_surface_threshold;
+    let t = o.free_surface_threshold(d);
     positive("scheme.isph.free_surface_threshold", t)?;
     if t >= d as f64 {
         return Err(SceneError::new(
