@@ -253,6 +253,15 @@ pub enum ReferenceSpec {
         /// Position of the lower wall \[m\].
         wall: f64,
     },
+    /// Hagen–Poiseuille start-up from rest (`meniscus_reference::pipe`) in a pipe of radius R
+    /// along `axis`, driven by the body force component along `axis`; viscosity and that
+    /// component come from each run's scene, the profile from its `radial_profile` probe.
+    HagenPoiseuille {
+        /// Pipe radius R \[m\].
+        radius: f64,
+        /// Index of the pipe's axis (0 = x, 1 = y, 2 = z; less than the scene's dimension).
+        axis: usize,
+    },
 }
 
 /// A figure of the case page (drawn from results.json only).

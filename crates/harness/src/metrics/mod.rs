@@ -42,6 +42,9 @@ pub fn compute(
         ReferenceSpec::PoiseuilleStartup { width, wall } => {
             poiseuille::compute(&poiseuille::channel(width, scene)?, wall, probes, steady_at)?
         }
+        ReferenceSpec::HagenPoiseuille { radius, axis } => {
+            poiseuille::compute(&poiseuille::pipe(radius, axis, scene)?, 0.0, probes, steady_at)?
+        }
         ReferenceSpec::EntranceFlow { width, wall } => {
             channel::compute(&channel::Channel::new(width, wall, scene)?, probes)?
         }
