@@ -69,6 +69,32 @@ fn ring_points<const D: usize>(center: &[f64], radius: f64, dx: f64) -> Vec<SVec
     rings(0.0, radius, dx).map(|(r, theta)| c + ring_offset::<D>(r, theta, 0, 1)).collect()
 }
 
+/// Concentric spherical shells filling the ball of `radius` about `center`
+/// (`Packing::Shells`): shell `k = 1..n`, `n = max(1, round(R/Δx))`, at `r_k = (k − ½) s`,
+/// `s = R/n`, holds `m_k = round(4π (k − ½)²)` points on the golden-angle spiral
+/// `z_j = 1 − (2j + 1)/m_k`, `φ_j = (j + k) π (3 − √5)` (González 2010, Math. Geosci.
+/// 42:49; the `+ k` turns each shell against the one inside it). The shell of radius `r_k`
+/// and thickness `s` has the volume `4π r_k² s`, so every point stands for about `s³`.
+fn shell_points<const D: usize>(center: &[f64], radius: f64, dx: f64) -> Vec<SVector<f64, D>> {
+    let c = SVector::<f64, D>::from_iterator(center.iter().copied());
+    let n = ((radius / dx).round() as usize).max(1);
+    let spacing = radius / n as f64;
+    let golden = std::f64::consts::PI * (3.0 - 5f64.sqrt());
+    let mut out = Vec::new();
+    for k in 1..=n {
+        let shell = k as f64 - 0.5;
+        let m = (4.0 * std::f64::consts::PI * shell * shell).round() as usize;
+        for j in 0..m {
+            let z = 1.0 - (2 * j + 1) as f64 / m as f64;
+            let rho = (1.0 - z * z).max(0.0).sqrt();
+            let (s, co) = ((j + k) as f64 * golden).sin_cos();
+            let dir = [rho * co, rho * s, z];
+            out.push(c + SVector::<f64, D>::from_fn(|i, _| shell * spacing * dir[i]));
+        }
+    }
+    out
+}
+
 /// The rings of the annulus `inner < ρ <= outer` as `(radius, angle)` pairs: with
 /// `inner = 0` those of [`ring_points`] (spacing `s = R/round(R/Δx)`); with `inner > 0` the
 /// rings of a disc of radius `inner` continued outward (`s = inner/round(inner/Δx)`, rings
@@ -181,6 +207,7 @@ pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector
 pub fn seed_points<const D: usize>(body: &Body, dx: f64) -> Vec<SVector<f64, D>> {
     match (body.packing, &body.shape) {
         (Packing::Rings, Shape::Circle { center, radius }) => ring_points::<D>(center, *radius, dx),
+        (Packing::Shells, Shape::Sphere { center, radius }) => shell_points::<D>(center, *radius, dx),
         (Packing::Rings, Shape::Cylinder { center, axis, radius, length, inner_radius }) => {
             cylinder_points::<D>(center, *axis, (*inner_radius, *radius, *length), dx, true)
         }
@@ -353,6 +380,30 @@ mod tests {
         for w in &wall {
             assert!(fluid.iter().all(|f| (w - f).norm() > 0.99 * dx));
         }
+    }
+
+    #[test]
+    fn shells_fill_the_ball_with_one_spacing_per_particle() {
+        let (r, dx) = (0.2, 0.02);
+        let pts = shell_points::<3>(&[0.1, 0.0, -0.3], r, dx);
+        // Σ_k round(4π (k − ½)²) for k = 1..10, against 4π R³/(3 Δx³) = 4188.8.
+        let want: usize =
+            (1..=10).map(|k| (4.0 * std::f64::consts::PI * (k as f64 - 0.5).powi(2)).round() as usize).sum();
+        assert_eq!(pts.len(), want);
+        assert!((want as f64 / 4188.8 - 1.0).abs() < 0.01, "{want}");
+        let c = SVector::<f64, 3>::new(0.1, 0.0, -0.3);
+        let outer = pts.iter().map(|x| (x - c).norm()).fold(0.0, f64::max);
+        assert!((outer - (r - 0.5 * dx)).abs() < 1e-12, "outer shell half a spacing inside R");
+        let centroid: SVector<f64, 3> = pts.iter().sum::<SVector<f64, 3>>() / pts.len() as f64;
+        assert!((centroid - c).norm() < 0.01 * dx, "{centroid}");
+        // No two particles closer than 0.8 Δx (the closest pair, 0.835 Δx, is in the
+        // innermost shell: three points at Δx/2).
+        let min = pts
+            .iter()
+            .enumerate()
+            .flat_map(|(i, a)| pts[i + 1..].iter().map(move |b| (a - b).norm()))
+            .fold(f64::INFINITY, f64::min);
+        assert!(min > 0.8 * dx, "closest pair {} dx", min / dx);
     }
 
     #[test]

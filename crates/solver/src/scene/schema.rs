@@ -142,6 +142,11 @@ pub enum Packing {
     /// continues the rings of a disc of radius `inner_radius` outward (spacing
     /// `inner_radius / round(inner_radius/Δx)`), so a pipe wall meets its fluid's rings.
     Rings,
+    /// Concentric spherical shells (a 3D sphere; the 3D counterpart of `rings`): shell
+    /// `k = 1..n`, `n = round(R/Δx)`, at radius `r_k = (k − ½) R/n` with `round(4π (k − ½)²)`
+    /// particles on a golden-angle (Fibonacci) spiral, so each particle stands for about
+    /// `Δx³` of the shell and the outer shell is a smooth sphere half a spacing inside `R`.
+    Shells,
 }
 
 impl Packing {

@@ -119,6 +119,13 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
                 "needs a circle in a 2D scene or a cylinder in a 3D scene (concentric rings fill a disc)",
             ));
         }
+        if body.packing == Packing::Shells && !(d == 3 && matches!(body.shape, Shape::Sphere { .. })) {
+            return Err(SceneError::new(
+                format!("bodies[{i}].packing"),
+                "shells",
+                "needs a sphere in a 3D scene (concentric spherical shells fill a ball)",
+            ));
+        }
         if let Some(j) = &body.jitter {
             let f = format!("bodies[{i}].jitter.fraction");
             finite(&f, j.fraction)?;
