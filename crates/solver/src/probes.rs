@@ -156,6 +156,29 @@ impl<const D: usize> ProbeSet<D> {
                     }
                     out.push(key, "p", if den > 0.0 { num / den } else { f64::NAN });
                 }
+                Probe::MeanPressure { center, radius } => {
+                    let q = Vector::<D>::from_fn(|i, _| center[i]);
+                    let (mut sum, mut count) = (0.0, 0usize);
+                    for (a, p) in x.iter().enumerate() {
+                        if s.domain.displacement(p, &q).norm() <= *radius {
+                            sum += s.particles.p[a];
+                            count += 1;
+                        }
+                    }
+                    out.push(key, "p", if count > 0 { sum / count as f64 } else { f64::NAN });
+                    out.push(key, "count", count as f64);
+                }
+                Probe::EllipsoidAxes {} => {
+                    let n = x.len() as f64;
+                    let c: Vector<D> = x.iter().sum::<Vector<D>>() / n;
+                    let m2 = x.iter().map(|p| (p - c).component_mul(&(p - c))).sum::<Vector<D>>() / n;
+                    for (i, name) in ["a_moment", "b_moment", "c_moment"].iter().enumerate().take(D) {
+                        out.push(key, name, (5.0 * m2[i]).sqrt());
+                    }
+                    for (i, name) in ["x_centroid", "y_centroid", "z_centroid"].iter().enumerate().take(D) {
+                        out.push(key, name, c[i]);
+                    }
+                }
                 Probe::KineticEnergy {} => {
                     let e: f64 = u.iter().map(|v| 0.5 * mass * v.norm_squared()).sum();
                     out.push(key, "e", e);
@@ -167,6 +190,13 @@ impl<const D: usize> ProbeSet<D> {
                     }
                     let lz: f64 = x.iter().zip(u).map(|(r, v)| mass * (r[0] * v[1] - r[1] * v[0])).sum();
                     out.push(key, "lz", lz);
+                    if D == 3 {
+                        let l = |i: usize, j: usize| -> f64 {
+                            x.iter().zip(u).map(|(r, v)| mass * (r[i] * v[j] - r[j] * v[i])).sum()
+                        };
+                        out.push(key, "lx", l(1, 2));
+                        out.push(key, "ly", l(2, 0));
+                    }
                 }
                 Probe::Disorder {} => {
                     let (search, list) = self.search.as_mut().expect("built for a disorder probe");

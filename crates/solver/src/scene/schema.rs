@@ -862,9 +862,23 @@ pub enum Probe {
         /// The point \[m\].
         point: Vec<f64>,
     },
+    /// Mean pressure `p` \[Pa\] of the fluid particles within `radius` of `center` (a
+    /// drop's inside pressure, averaged over many particles instead of one support), and
+    /// their number `count`.
+    MeanPressure {
+        /// Centre of the ball (disc in 2D) \[m\].
+        center: Vec<f64>,
+        /// Its radius \[m\].
+        radius: f64,
+    },
+    /// Ellipsoid semi-axes of the fluid (3D): `a_moment`, `b_moment`, `c_moment`
+    /// (√(5⟨x_i²⟩) about the centroid along x, y, z: the semi-axes of the uniform ellipsoid
+    /// with the same second moments) \[m\], and `x_centroid`, `y_centroid`, `z_centroid`.
+    EllipsoidAxes {},
     /// Total kinetic energy per unit depth `e` \[J/m in 2D\].
     KineticEnergy {},
-    /// Linear momentum components `px`, `py`(, `pz`) and angular momentum `lz` about the origin.
+    /// Linear momentum components `px`, `py`(, `pz`) and angular momentum `lz` (3D also
+    /// `lx`, `ly`) about the origin.
     Momentum {},
     /// Particle disorder: `min_pair_over_dx`, `close_fraction` (neighbour closer than 0.5 Δx).
     Disorder {},
@@ -990,6 +1004,8 @@ impl Probe {
         match self {
             Probe::EllipseAxes {} => "ellipse_axes",
             Probe::PressureAt { .. } => "pressure_at",
+            Probe::MeanPressure { .. } => "mean_pressure",
+            Probe::EllipsoidAxes {} => "ellipsoid_axes",
             Probe::KineticEnergy {} => "kinetic_energy",
             Probe::Momentum {} => "momentum",
             Probe::Disorder {} => "disorder",

@@ -150,6 +150,19 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         if let Probe::PressureAt { point } = probe {
             vector(&format!("probes[{i}].pressure_at.point"), point, d)?;
         }
+        if let Probe::MeanPressure { center, radius } = probe {
+            vector(&format!("probes[{i}].mean_pressure.center"), center, d)?;
+            positive(&format!("probes[{i}].mean_pressure.radius"), *radius)?;
+        }
+        if let Probe::EllipsoidAxes {} = probe
+            && d != 3
+        {
+            return Err(SceneError::new(
+                format!("probes[{i}].ellipsoid_axes"),
+                "{}",
+                "is defined for 3D scenes only (ellipse_axes in 2D)",
+            ));
+        }
         if let Probe::EllipseAxes {} = probe
             && d != 2
         {

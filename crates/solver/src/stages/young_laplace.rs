@@ -25,8 +25,9 @@
 //!   derivative of the colour.
 //! - Offset: the free-surface particles sit half a spacing inside the surface of the
 //!   volume they represent; the surface there is parallel to theirs, with curvature
-//!   `κ_s = κ̄ / (1 + κ̄ Δx/2)` (a circle of radius 1/κ̄ grown by Δx/2), after clamping
-//!   `|κ̄| ≤ 1/Δx` (no radius of curvature below one spacing is resolved).
+//!   `κ_s = κ̄ / (1 + κ̄ Δx / (2(D − 1)))` (`κ̄` sums the D − 1 principal curvatures: a
+//!   circle of radius 1/κ̄, a sphere of radius 2/κ̄, grown by Δx/2), after clamping
+//!   `|κ̄| ≤ (D − 1)/Δx` (no radius of curvature below one spacing is resolved).
 //!
 //! The free-surface Dirichlet value is `p_a = σ κ_s,a` \[Pa\]; the PPE moves it to the
 //! right-hand side (`isph::projection::PpeAssemble::surface_pressure`).
@@ -131,12 +132,14 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for SurfacePressure<K, D> {
             })
             .collect();
         shepard(s, &self.kernel, &raw, &mut self.kappa);
-        let (sigma, half) = (self.sigma, 0.5 * s.dx);
+        // κ is the sum of the D − 1 principal curvatures: each at most 1/Δx, each radius
+        // grown by Δx/2 to the surface.
+        let (sigma, half, m) = (self.sigma, 0.5 * s.dx, (D - 1) as f64);
         let (kappa, fs) = (&self.kappa, &s.particles.free_surface);
         s.particles.p[..nf].par_iter_mut().enumerate().with_min_len(1024).for_each(|(a, p)| {
             if fs[a] {
-                let k = kappa[a].clamp(-0.5 / half, 0.5 / half);
-                *p = if k.is_finite() { sigma * k / (1.0 + k * half) } else { 0.0 };
+                let k = kappa[a].clamp(-0.5 * m / half, 0.5 * m / half);
+                *p = if k.is_finite() { sigma * k / (1.0 + k * half / m) } else { 0.0 };
             }
         });
         Ok(())
