@@ -217,7 +217,8 @@ pub enum ReferenceSpec {
         /// Position of the lower wall \[m\].
         wall: f64,
     },
-    /// A 2D drop at rest: Laplace pressure `σ/R` and spurious currents
+    /// A drop at rest, a circle (2D) or a sphere (3D) after the scene's `dimension`: Laplace
+    /// pressure `σ/R` (2D) or `2σ/R` (3D) and spurious currents
     /// (`meniscus_reference::capillarity`).
     StaticDrop {
         /// Radius R \[m\].
@@ -225,8 +226,9 @@ pub enum ReferenceSpec {
         /// Surface tension σ \[N/m\].
         sigma: f64,
     },
-    /// Mode-2 oscillation of a 2D drop: period `2π √(ρR³/(6σ))` and damping `4ν/R²` (ν from
-    /// each run's scene).
+    /// Mode-2 oscillation of a drop, 2D or 3D after the scene's `dimension`: period
+    /// `2π √(ρR³/(6σ))` and damping `4ν/R²` in 2D, `2π √(ρR³/(8σ))` and `5ν/R²` in 3D (ν
+    /// from each run's scene).
     OscillatingDrop {
         /// Radius R \[m\].
         radius: f64,

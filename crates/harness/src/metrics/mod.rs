@@ -52,16 +52,22 @@ pub fn compute(
             let patch = meniscus_reference::rotating_square::RotatingSquare::new(side, omega, density)?;
             rotating_square::compute(&patch, &rotating_square::pressure_points(scene), probes)?
         }
+        // The capillarity references take the run's dimension (2 or 3, 2 when absent) from
+        // the scene.
         ReferenceSpec::StaticDrop { radius, sigma } => {
-            capillarity::compute(&capillarity::Capillary::Static { radius, sigma }, probes)?
+            let dim = capillarity::dimension(scene)?;
+            capillarity::compute_in(dim, &capillarity::Capillary::Static { radius, sigma }, probes)?
         }
         ReferenceSpec::OscillatingDrop { radius, sigma, density } => {
+            let dim = capillarity::dimension(scene)?;
             let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
             let nu = num(&scene["fluid"]["viscosity"]) / num(&scene["fluid"]["density"]);
-            capillarity::compute(&capillarity::Capillary::Oscillating { radius, sigma, density, nu }, probes)?
+            let case = capillarity::Capillary::Oscillating { radius, sigma, density, nu };
+            capillarity::compute_in(dim, &case, probes)?
         }
         ReferenceSpec::SquareDrop { side, sigma, density } => {
-            capillarity::compute(&capillarity::Capillary::Square { side, sigma, density }, probes)?
+            let dim = capillarity::dimension(scene)?;
+            capillarity::compute_in(dim, &capillarity::Capillary::Square { side, sigma, density }, probes)?
         }
     };
     m.metrics.insert("particles".into(), particles as f64);
@@ -173,6 +179,26 @@ mod tests {
         assert!(rel_err_max(&[1.0, f64::NAN, 1.0], &[1.0, 1.0, 1.0]).is_nan());
         assert!(nan_max(&[0.1, f64::NAN]).is_nan());
         assert!((nan_max(&[0.1, 0.3, 0.2]) - 0.3).abs() < 1e-15);
+    }
+
+    #[test]
+    fn capillarity_dimension_comes_from_the_scene() {
+        use serde_json::json;
+        let (radius, sigma) = (0.2, 1.0);
+        let t: Vec<f64> = (0..=10).map(|i| i as f64 * 0.1).collect();
+        let mut probes = ProbeRecord { t: t.clone(), ..Default::default() };
+        probes
+            .series
+            .entry("mean_pressure".into())
+            .or_default()
+            .insert("p".into(), vec![2.0 * sigma / radius; t.len()]);
+        let reference = ReferenceSpec::StaticDrop { radius, sigma };
+        let err = |scene: serde_json::Value| compute(&reference, &scene, &probes, 1, None).unwrap().metrics["dp_rel_err_late"];
+        // 2σ/R is exact for a sphere and twice σ/R for a circle (also without `dimension`).
+        assert!(err(json!({ "dimension": 3 })).abs() < 1e-12);
+        assert!((err(json!({ "dimension": 2 })) - 1.0).abs() < 1e-12);
+        assert!((err(json!({})) - 1.0).abs() < 1e-12);
+        assert!(compute(&reference, &json!({ "dimension": 5 }), &probes, 1, None).is_err());
     }
 
     #[test]
