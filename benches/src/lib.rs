@@ -71,6 +71,18 @@ pub fn periodic_channel() -> Vec<BenchScene> {
     vec![BenchScene { label: "channel_d36".into(), scene }]
 }
 
+/// The 3D pipe of `validation/hagen_poiseuille.json` (ISPH, its template's options) at
+/// R/Δx = 24: 65 160 fluid particles in rings and 50 688 dummy wall particles in the shell,
+/// 115 848 in all (issue #36: a 3D step at about 100 k particles).
+pub fn pipe_3d() -> BenchScene {
+    let case: serde_json::Value =
+        serde_json::from_str(include_str!("../../validation/hagen_poiseuille.json"))
+            .expect("the committed case file is JSON");
+    let mut scene = Scene::from_json(&case["scene"].to_string()).expect("the committed pipe scene is valid");
+    scene.dx = 0.01 / 24.0;
+    BenchScene { label: "pipe3d_r24".into(), scene }
+}
+
 /// Every benched scene: the drops, then the channel.
 pub fn scenes() -> Vec<BenchScene> {
     let mut s = elliptical_drop();
@@ -180,17 +192,18 @@ impl StageBench {
     }
 }
 
-/// Whole steps of a 2D scene, each from the same state (restored untimed before each).
+/// Whole steps of a scene of dimension `D` (2 by default), each from the same state
+/// (restored untimed before each).
 #[derive(Debug)]
-pub struct StepBench {
-    stepper: Stepper<2>,
-    snapshot: Snapshot<2>,
+pub struct StepBench<const D: usize = 2> {
+    stepper: Stepper<D>,
+    snapshot: Snapshot<D>,
 }
 
-impl StepBench {
+impl<const D: usize> StepBench<D> {
     /// Steps `scene` [`WARM_STEPS`] times and saves the state.
     pub fn new(scene: &Scene) -> Self {
-        let mut stepper = Stepper::<2>::new(scene).expect("bench scenes are valid");
+        let mut stepper = Stepper::<D>::new(scene).expect("bench scenes are valid");
         on_worker(|| {
             for _ in 0..WARM_STEPS {
                 stepper.step_once().expect("the warm-up steps are stable");
@@ -249,13 +262,20 @@ mod tests {
         assert!(st.particles.total() > st.particles.len(), "mirror particles added");
         let mut implicit = StageBench::new(&with_implicit_viscosity(ch), "viscosity_implicit", true).unwrap();
         assert!(implicit.time(2) > Duration::ZERO);
-        let mut step = StepBench::new(ch);
+        let mut step = StepBench::<2>::new(ch);
         assert!(step.time(1) > Duration::ZERO);
     }
 
     #[test]
+    fn the_3d_pipe_bench_has_about_100k_particles() {
+        let stepper = Stepper::<3>::new(&pipe_3d().scene).expect("valid");
+        let p = &stepper.state().particles;
+        assert_eq!((p.len(), p.total()), (65_160, 115_848));
+    }
+
+    #[test]
     fn step_bench_restarts_from_the_saved_state() {
-        let mut b = StepBench::new(&drop_scene(0.05, 10));
+        let mut b = StepBench::<2>::new(&drop_scene(0.05, 10));
         assert!(b.time(2) > Duration::ZERO);
         assert_eq!(b.stepper.steps(), WARM_STEPS + 1);
     }
