@@ -31,7 +31,7 @@ pub struct RunRecord {
     pub summary: meniscus::Summary,
     /// The solver's `probes.json` content (non-finite samples written as `null`).
     pub probes: CachedProbes,
-    /// The particles at the scene's `output.snapshot_times` (2D runs; absent when none).
+    /// The particles at the scene's `output.snapshot_times` (absent when none).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub snapshots: Vec<crate::snapshots::Snapshot>,
     /// CPU time of the threads that ran the run (user + system) \[s\]; absent off Linux.

@@ -332,7 +332,10 @@ pub enum Figure {
     /// Particle positions coloured by pressure at each snapshot time of the runs
     /// (`output.snapshot_times`), one panel per preset side by side with a shared colour
     /// bar: `<file>_<i>.svg` for the i-th time. Drawn from `snapshots/<slug>.json`; a preset
-    /// without snapshots (not run in this tier) is left out.
+    /// without snapshots (not run in this tier) is left out. A 3D run is drawn as a cut:
+    /// the particles within Δx/2 (the run's spacing) of the plane normal to `cut_axis`
+    /// through the fluid's centroid, seen in that plane
+    /// ([`crate::snapshots::Snapshot::view`]).
     Snapshots {
         /// File stem.
         file: String,
@@ -344,7 +347,39 @@ pub enum Figure {
         /// Spacing of the runs shown (the finest with snapshots when absent).
         #[serde(default, skip_serializing_if = "Option::is_none")]
         dx: Option<f64>,
+        /// 3D runs: the axis normal to the cut plane, 0 (x), 1 (y) or 2 (z); absent: 1, the
+        /// x–z plane (a drop falling or oscillating along z). The panels show the plane's
+        /// two other axes in increasing order. Only for a case with 3D runs.
+        #[serde(default, skip_serializing_if = "Option::is_none")]
+        cut_axis: Option<usize>,
     },
+}
+
+impl Figure {
+    /// The cut axis of a snapshot figure when absent (y: the x–z plane).
+    pub const DEFAULT_CUT_AXIS: usize = 1;
+
+    /// Rules beyond the schema that need nothing but the figure; the message begins with
+    /// the field.
+    pub fn check(&self) -> std::result::Result<(), String> {
+        match self {
+            Figure::Snapshots { cut_axis: Some(a), .. } if *a > 2 => Err(format!(
+                "`snapshots.cut_axis` = {a}: must be 0, 1 or 2 (the axis normal to the cut plane: x, y or z)"
+            )),
+            _ => Ok(()),
+        }
+    }
+
+    /// The file stem.
+    pub fn file(&self) -> &str {
+        match self {
+            Figure::History { file, .. }
+            | Figure::Convergence { file, .. }
+            | Figure::Cost { file, .. }
+            | Figure::ErrorHistory { file, .. }
+            | Figure::Snapshots { file, .. } => file,
+        }
+    }
 }
 
 impl Case {
@@ -445,6 +480,18 @@ impl Case {
                 return Err(err(format!("`{field}.values` has dx = {d}, not a spacing of `sweep.dx`")));
             }
         }
+        for f in &self.figures {
+            let named = |m: String| err(format!("figure `{}`: {m}", f.file()));
+            f.check().map_err(named)?;
+            if let Figure::Snapshots { cut_axis: Some(a), .. } = f
+                && !self.has_3d_runs()
+            {
+                return Err(named(format!(
+                    "`snapshots.cut_axis` = {a}: only for 3D runs, and every preset's scene is 2D \
+                     (drawn whole in the x–y plane)"
+                )));
+            }
+        }
         for c in &self.checks {
             c.validate().map_err(|m| err(format!("check `{}`: {m}", c.display_name())))?;
             self.check_selector(c).map_err(|m| err(format!("check `{}`: {m}", c.display_name())))?;
@@ -538,6 +585,14 @@ impl Case {
             }
         }
         Ok(())
+    }
+
+    /// Whether a preset runs a 3D scene (`dimension` of the template or its patch).
+    fn has_3d_runs(&self) -> bool {
+        self.sweep.presets.iter().any(|p| {
+            p.patch.get("dimension").or_else(|| self.scene.get("dimension")).and_then(|d| d.as_u64())
+                == Some(3)
+        })
     }
 
     /// The scheme a preset runs: the key of the scene's `scheme` once the preset's patch
@@ -688,5 +743,34 @@ mod tests {
             let e = error(edit.clone());
             assert!(e.contains(says), "{edit}: {e}");
         }
+    }
+
+    /// `snapshots.cut_axis` is 0, 1 or 2, in a case with 3D runs; absent, it is not
+    /// written back.
+    #[test]
+    fn snapshot_cut_axis_is_an_axis_of_a_3d_case() {
+        let error = |case: &Case, figure: serde_json::Value| {
+            let mut v = serde_json::to_value(case).unwrap();
+            v["figures"] = serde_json::json!([{ "snapshots": figure }]);
+            Case::from_json(&v.to_string(), Path::new("x.json")).err().map(|e| e.to_string())
+        };
+        let pipe = testing::committed("hagen_poiseuille");
+        let preset = pipe.primary_preset().to_string();
+        for a in 0..3 {
+            assert_eq!(
+                error(&pipe, serde_json::json!({"file": "s", "presets": [preset], "cut_axis": a})),
+                None
+            );
+        }
+        let e = error(&pipe, serde_json::json!({"file": "s", "presets": [preset], "cut_axis": 3})).unwrap();
+        assert!(e.contains("figure `s`: `snapshots.cut_axis` = 3: must be 0, 1 or 2"), "{e}");
+        let drop = repo_case();
+        assert_eq!(error(&drop, serde_json::json!({"file": "s", "presets": ["paper"]})), None);
+        let e = error(&drop, serde_json::json!({"file": "s", "presets": ["paper"], "cut_axis": 1})).unwrap();
+        assert!(e.contains("`snapshots.cut_axis` = 1: only for 3D runs"), "{e}");
+        let fig: Figure =
+            serde_json::from_value(serde_json::json!({"snapshots": {"file": "s", "presets": []}})).unwrap();
+        assert!(matches!(fig, Figure::Snapshots { cut_axis: None, .. }));
+        assert!(!serde_json::to_string(&fig).unwrap().contains("cut_axis"));
     }
 }

@@ -301,7 +301,11 @@ impl Runner {
                     scene: spec.scene_json.clone(),
                     summary: report.summary,
                     probes: CachedProbes::from(report.probes),
-                    snapshots: report.snapshots.iter().map(Snapshot::from).collect(),
+                    snapshots: report
+                        .snapshots
+                        .iter()
+                        .map(|f| Snapshot::new(f, spec.scene.dimension))
+                        .collect(),
                     cpu_s,
                     threads: Some(threads),
                 };

@@ -16,9 +16,10 @@ pub use html::ExtraPage;
 use crate::baseline::{self, Comparison, NoiseBand};
 use crate::case::{CaseRecord, Figure};
 use crate::checks::same_spacing;
-use crate::error::Result;
+use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::results::{CaseResults, RunResult, Summary, case_dirs};
+use crate::snapshots::AXES;
 use std::path::{Path, PathBuf};
 
 /// A figure written next to a case page.
@@ -75,8 +76,17 @@ pub fn render_case(
                 io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
                 figures.push(FigureFile { file: name, caption: title.clone() });
             }
-            Figure::Snapshots { file, title, presets, dx } => {
-                snapshot_figures(case_dir, &runs, file, title, presets, *dx, &mut figures)?;
+            Figure::Snapshots { file, title, presets, dx, cut_axis } => {
+                fig.check()
+                    .map_err(|m| HarnessError::case(&results.case, format!("figure `{file}`: {m}")))?;
+                let spec = SnapshotSpec {
+                    file,
+                    title,
+                    presets,
+                    dx: *dx,
+                    cut_axis: cut_axis.unwrap_or(Figure::DEFAULT_CUT_AXIS),
+                };
+                snapshot_figures(case_dir, &runs, &spec, &mut figures)?;
             }
         }
     }
@@ -107,17 +117,25 @@ fn per_preset(
     Ok(())
 }
 
-/// Draws the snapshot figures of `presets` (see [`Figure::Snapshots`]): one SVG per
-/// snapshot time, the presets' panels side by side.
+/// The fields of a [`Figure::Snapshots`], its cut axis resolved.
+struct SnapshotSpec<'a> {
+    file: &'a str,
+    title: &'a str,
+    presets: &'a [String],
+    dx: Option<f64>,
+    cut_axis: usize,
+}
+
+/// Draws the snapshot figures of `spec.presets` (see [`Figure::Snapshots`]): one SVG per
+/// snapshot time, the presets' panels side by side; a 3D run cut by the plane normal to
+/// `spec.cut_axis` through the fluid's centroid.
 fn snapshot_figures(
     case_dir: &Path,
     runs: &[&RunResult],
-    file: &str,
-    title: &str,
-    presets: &[String],
-    dx: Option<f64>,
+    spec: &SnapshotSpec,
     figures: &mut Vec<FigureFile>,
 ) -> Result<()> {
+    let SnapshotSpec { file, title, presets, dx, cut_axis } = *spec;
     let with_snapshots: Vec<(&RunResult, crate::snapshots::SnapshotFile)> = runs
         .iter()
         .filter(|r| presets.contains(&r.preset) && dx.is_none_or(|d| same_spacing(r.dx, d)))
@@ -134,27 +152,50 @@ fn snapshot_figures(
         .collect();
     let times = shown.iter().map(|s| s.frames.len()).max().unwrap_or(0);
     for i in 0..times {
-        let panels: Vec<(String, &crate::snapshots::Snapshot)> = shown
+        let panels: Vec<(String, f64, crate::snapshots::View)> = shown
             .iter()
             .filter_map(|s| {
                 let f = s.frames.get(i)?;
+                let view = f.view(cut_axis, s.dx);
                 let note = if s.status == "ok" { "" } else { " (diverged later)" };
-                Some((format!("{}, t = {:.4} s{note}", s.preset, f.time), f))
+                let plane = view.cut.map_or(String::new(), |c| {
+                    format!(", cut {} = {} m", AXES[c.axis], plane_coordinate(c.centre, s.dx))
+                });
+                Some((format!("{}, t = {:.4} s{plane}{note}", s.preset, f.time), f.time, view))
             })
             .collect();
-        let t = panels.first().map_or(0.0, |p| p.1.time);
+        let t = panels.first().map_or(0.0, |p| p.1);
         let name = format!("{file}_{i}.svg");
-        let caption = format!(
+        let mut caption = format!(
             "{title} — t = {t:.4} s, dx = {}; colour: pressure [Pa], one scale for both panels \
              (clipped to the 1st–99th percentile)",
             html::format_dx(finest)
         );
-        let heading = format!("{title}, dx = {}", html::format_dx(finest));
-        let svg = plots::snapshots(&name, &heading, &panels)?;
+        let mut heading = format!("{title}, dx = {}", html::format_dx(finest));
+        if let Some((_, _, view)) = panels.iter().find(|(_, _, v)| v.cut.is_some()) {
+            let [n, h, v] = [cut_axis, view.axes[0], view.axes[1]].map(|a| AXES[a]);
+            heading.push_str(&format!("; cut −Δx/2 ≤ {n} − {n}_c < Δx/2"));
+            caption.push_str(&format!(
+                "; 3D: the particles within Δx/2 of the plane {n} = {n}_c through the fluid's \
+                 centroid (−Δx/2 ≤ {n} − {n}_c < Δx/2, {n}_c in each panel's title), seen in the \
+                 {h}–{v} plane"
+            ));
+        }
+        let views: Vec<(String, &crate::snapshots::View)> =
+            panels.iter().map(|(label, _, view)| (label.clone(), view)).collect();
+        let svg = plots::snapshots(&name, &heading, &views)?;
         io::write_atomic(&case_dir.join(&name), svg.as_bytes())?;
         figures.push(FigureFile { file: name, caption });
     }
     Ok(())
+}
+
+/// The coordinate `c` \[m\] of a cut plane, to a hundredth of the spacing `dx` (no `-0`).
+fn plane_coordinate(c: f64, dx: f64) -> String {
+    let digits = (2.0 - dx.log10().floor()).clamp(0.0, 12.0) as usize;
+    let scale = 10f64.powi(digits as i32);
+    let rounded = (c * scale).round() / scale;
+    format!("{:.digits$}", if rounded == 0.0 { 0.0 } else { rounded })
 }
 
 /// Every `<out>/<case>/results.json` present, sorted by case name.
@@ -367,6 +408,7 @@ mod tests {
                 step: 1,
                 x: vec![0.0, 0.1],
                 y: vec![0.0, 0.1],
+                z: Vec::new(),
                 p: vec![-1.0, 0.0],
             };
             let file = crate::snapshots::SnapshotFile {
@@ -392,8 +434,68 @@ mod tests {
             svg.contains("shifting, t = 0.0500 s")
                 && svg.contains("no_shifting, t = 0.0500 s (diverged later)")
         );
+        assert!(
+            !svg.contains("cut") && svg.contains(">\nx [m]\n<") && svg.contains(">\ny [m]\n<"),
+            "2D: no cut"
+        );
         let page = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
         assert!(page.contains("snapshots_1.svg"));
+    }
+
+    /// 3D snapshots are cut by the plane y = y_c (the default `cut_axis`) through the
+    /// fluid's centroid, and the figure says so: a lattice ball of 257 particles shows the
+    /// 49 of its central plane in each panel, in x–z.
+    #[test]
+    fn snapshot_figures_cut_3d_runs() {
+        let dir = Scratch::new("report-snapshots-3d");
+        let mut case = crate::case::testing::committed("rotating_square");
+        case.figures = vec![Figure::Snapshots {
+            file: "cut".into(),
+            title: "Ball".into(),
+            presets: vec!["shifting".into(), "no_shifting".into()],
+            dx: None,
+            cut_axis: None,
+        }];
+        let mut results: CaseResults = serde_json::from_str(FIXTURE).unwrap();
+        results.runs.truncate(2);
+        results.runs[0].preset = "shifting".into();
+        results.runs[1].preset = "no_shifting".into();
+        for r in &mut results.runs {
+            r.dx = 0.02;
+            let file = crate::snapshots::SnapshotFile {
+                slug: r.slug(),
+                preset: r.preset.clone(),
+                dx: r.dx,
+                status: "ok".into(),
+                frames: vec![crate::snapshots::tests::ball(0.02, [0.1, 0.2, 0.3])],
+            };
+            crate::snapshots::store(dir.path(), &file).unwrap();
+        }
+        let record = CaseRecord { case, provenance: Provenance::default(), scene_hashes: Default::default() };
+        let figs = render_case(dir.path(), &results, Some(&record), None).unwrap();
+        assert_eq!(figs.len(), 1);
+        assert!(figs[0].caption.contains("plane y = y_c") && figs[0].caption.contains("x–z plane"));
+        let svg = std::fs::read_to_string(dir.path().join("cut_0.svg")).unwrap();
+        assert_eq!(svg.matches("<circle").count(), 2 * 49, "the central plane of each ball");
+        assert!(svg.contains("shifting, t = 0.5000 s, cut y = 0.2000 m"), "{svg}");
+        assert!(svg.contains("cut −Δx/2 ≤ y − y_c &lt; Δx/2"));
+        assert!(svg.contains(">\nx [m]\n<") && svg.contains(">\nz [m]\n<") && !svg.contains(">\ny [m]\n<"));
+        // A cut axis beyond z (a hand-edited provenance.json) is an error naming the field.
+        let mut bad = record.clone();
+        if let Figure::Snapshots { cut_axis, .. } = &mut bad.case.figures[0] {
+            *cut_axis = Some(3);
+        }
+        let e = render_case(dir.path(), &results, Some(&bad), None).unwrap_err().to_string();
+        assert!(e.contains("figure `cut`: `snapshots.cut_axis` = 3: must be 0, 1 or 2"), "{e}");
+    }
+
+    #[test]
+    fn plane_coordinates_are_rounded_to_the_spacing() {
+        assert_eq!(plane_coordinate(0.012_345, 0.02), "0.0123");
+        assert_eq!(plane_coordinate(-1e-17, 0.02), "0.0000");
+        assert_eq!(plane_coordinate(0.2, 0.01), "0.2000");
+        assert_eq!(plane_coordinate(1.5e-3, 1e-4), "0.001500");
+        assert_eq!(plane_coordinate(12.0, 2.0), "12.00");
     }
 
     #[test]

@@ -464,24 +464,24 @@ fn quantile(values: &[f64], q: f64) -> Option<f64> {
     Some(v[((v.len() - 1) as f64 * q).round() as usize])
 }
 
-/// Particle scatter plots coloured by pressure: one square panel per `(label, snapshot)`
-/// side by side, the same axes and colour scale for all (the 1st–99th percentile of the
-/// pressures, so that a few outliers do not wash out the rest), and a colour bar.
-pub fn snapshots(
-    file: &str,
-    title: &str,
-    panels: &[(String, &crate::snapshots::Snapshot)],
-) -> Result<String> {
+/// Particle scatter plots coloured by pressure: one square panel per `(label, view)` side
+/// by side (a 2D snapshot or the cut of a 3D one, [`crate::snapshots::Snapshot::view`]),
+/// the same axes (those of the first view) and colour scale for all (the 1st–99th
+/// percentile of the pressures, so that a few outliers do not wash out the rest), and a
+/// colour bar.
+pub fn snapshots(file: &str, title: &str, panels: &[(String, &crate::snapshots::View)]) -> Result<String> {
     const PANEL: u32 = 430;
     const BAR: u32 = 140;
+    let [x_desc, y_desc] =
+        panels.first().map_or([0, 1], |(_, v)| v.axes).map(|a| format!("{} [m]", crate::snapshots::AXES[a]));
     let all_p: Vec<f64> = panels.iter().flat_map(|(_, s)| s.p.iter().copied()).collect();
     let (mut p0, mut p1) = (quantile(&all_p, 0.01).unwrap_or(0.0), quantile(&all_p, 0.99).unwrap_or(1.0));
     if p1 - p0 <= 1e-12 * p0.abs().max(p1.abs()).max(1e-300) {
         let pad = p0.abs().max(1.0) * 0.5;
         (p0, p1) = (p0 - pad, p1 + pad);
     }
-    let (x0, x1) = range(panels.iter().flat_map(|(_, s)| s.x.iter().copied()), 0.04);
-    let (y0, y1) = range(panels.iter().flat_map(|(_, s)| s.y.iter().copied()), 0.04);
+    let (x0, x1) = range(panels.iter().flat_map(|(_, s)| s.h.iter().copied()), 0.04);
+    let (y0, y1) = range(panels.iter().flat_map(|(_, s)| s.v.iter().copied()), 0.04);
     // Equal scales on both axes: a square panel shows the larger extent on both.
     let half = 0.5 * (x1 - x0).max(y1 - y0);
     let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
@@ -498,9 +498,9 @@ pub fn snapshots(
                 .y_label_area_size(45)
                 .build_cartesian_2d(xr.clone(), yr.clone())
                 .map_err(boxed)?;
-            chart.configure_mesh().disable_mesh().x_desc("x [m]").y_desc("y [m]").draw().map_err(boxed)?;
+            chart.configure_mesh().disable_mesh().x_desc(&x_desc).y_desc(&y_desc).draw().map_err(boxed)?;
             let pts =
-                snap.x.iter().zip(&snap.y).zip(&snap.p).filter(|((x, y), _)| x.is_finite() && y.is_finite());
+                snap.h.iter().zip(&snap.v).zip(&snap.p).filter(|((x, y), _)| x.is_finite() && y.is_finite());
             chart
                 .draw_series(
                     pts.map(|((&x, &y), &p)| Circle::new((x, y), 2, viridis((p - p0) / (p1 - p0)).filled())),
@@ -558,15 +558,33 @@ mod snapshot_tests {
             step: 100,
             x: (0..50).map(|i| (i % 10) as f64 * 0.1 + shift).collect(),
             y: (0..50).map(|i| (i / 10) as f64 * 0.1).collect(),
+            z: Vec::new(),
             p: (0..50).map(|i| -1e5 * i as f64).collect(),
         };
-        let (a, b) = (snap(0.0), snap(0.01));
+        let (a, b) = (snap(0.0).view(1, 0.1), snap(0.01).view(1, 0.1));
         let svg =
             snapshots("s.svg", "Snapshots", &[("shifting".into(), &a), ("no_shifting".into(), &b)]).unwrap();
         assert!(svg.starts_with("<svg") && svg.contains("no_shifting") && svg.contains("p [Pa]"));
-        assert!(svg.matches("<circle").count() >= 100, "one marker per particle");
+        assert!(svg.contains("x [m]") && svg.contains("y [m]"));
+        assert_eq!(svg.matches("<circle").count(), 100, "one marker per particle");
         // A uniform field (t = 0: p = 0 everywhere) still draws.
-        let flat = Snapshot { p: vec![0.0; 50], ..snap(0.0) };
+        let flat = Snapshot { p: vec![0.0; 50], ..snap(0.0) }.view(1, 0.1);
         assert!(snapshots("f.svg", "t = 0", &[("shifting".into(), &flat)]).is_ok());
+    }
+
+    /// A 3D lattice ball cut by each plane through its centre: one marker per particle of
+    /// that plane (49 of 257), the plane's two axes on the panel.
+    #[test]
+    fn a_3d_snapshot_draws_its_cut() {
+        let ball = crate::snapshots::tests::ball(0.01, [0.0, 0.0, 0.05]);
+        for (axis, [h, v]) in [(0, ["y", "z"]), (1, ["x", "z"]), (2, ["x", "y"])] {
+            let view = ball.view(axis, 0.01);
+            let svg = snapshots("c.svg", "Cut", &[("paper".into(), &view), ("tuned".into(), &view)]).unwrap();
+            assert_eq!(svg.matches("<circle").count(), 2 * 49, "axis {axis}");
+            assert!(
+                svg.contains(&format!(">\n{h} [m]\n<")) && svg.contains(&format!(">\n{v} [m]\n<")),
+                "axis {axis}"
+            );
+        }
     }
 }
