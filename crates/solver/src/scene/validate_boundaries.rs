@@ -28,15 +28,7 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
             axis(&format!("{f}.axis"), *a, d)?;
             axis(&format!("{f}.component"), *component, d)?;
             ordered(&format!("{f}.range"), range)?;
-            let n = bins.unwrap_or(((range[1] - range[0]) / scene.dx).round() as usize);
-            if !(1..=999).contains(&n) {
-                let rule = if bins.is_some() {
-                    "must be between 1 and 999"
-                } else {
-                    "(one per row of Δx) must be between 1 and 999"
-                };
-                return Err(SceneError::new(format!("{f}.bins"), n, rule));
-            }
+            profile_bins(&f, *bins, (range[1] - range[0]) / scene.dx)?;
             if let Some(slab) = slab {
                 axis(&format!("{f}.slab.axis"), slab.axis, d)?;
                 ordered(&format!("{f}.slab.range"), &slab.range)?;
@@ -67,15 +59,7 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
             if *radius <= 0.0 {
                 return Err(SceneError::new(format!("{f}.radius"), radius, "must be positive"));
             }
-            let n = bins.unwrap_or((radius / scene.dx).round() as usize);
-            if !(1..=999).contains(&n) {
-                let rule = if bins.is_some() {
-                    "must be between 1 and 999"
-                } else {
-                    "(one per Δx) must be between 1 and 999"
-                };
-                return Err(SceneError::new(format!("{f}.bins"), n, rule));
-            }
+            profile_bins(&f, *bins, radius / scene.dx)?;
         }
     }
     let mut last = 0.0;
@@ -214,6 +198,18 @@ fn open_boundaries(scene: &Scene) -> Result<(), SceneError> {
         ));
     }
     Ok(())
+}
+
+/// A profile probe's bin count at `f`: `bins`, or one per Δx over an extent of `rows` Δx,
+/// must be 1 to 999 (three-digit keys).
+fn profile_bins(f: &str, bins: Option<usize>, rows: f64) -> Result<(), SceneError> {
+    let n = bins.unwrap_or(rows.round() as usize);
+    if (1..=999).contains(&n) {
+        return Ok(());
+    }
+    let rule =
+        if bins.is_some() { "must be between 1 and 999" } else { "(one per Δx) must be between 1 and 999" };
+    Err(SceneError::new(format!("{f}.bins"), n, rule))
 }
 
 /// Most snapshot times a scene may ask for.
