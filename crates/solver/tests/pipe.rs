@@ -147,6 +147,24 @@ fn bad_pipes_are_errors_naming_the_field() {
             Box::new(|v| v["bodies"][1]["shape"]["cylinder"]["radius"] = json!(R)),
         ),
         (
+            // A cross-section too wide to scan.
+            "bodies[1].shape.cylinder.radius",
+            Box::new(|v| v["bodies"][1]["shape"]["cylinder"]["radius"] = json!(4000.0 * R / 6.0)),
+        ),
+        (
+            // Rings inside a radius below dx would be closer than dx.
+            "bodies[0].shape.cylinder.inner_radius",
+            Box::new(|v| v["bodies"][0]["shape"]["cylinder"]["inner_radius"] = json!(0.5 * R / 6.0)),
+        ),
+        (
+            // A wall shell whose rings (spacing 6.4/6 dx here, the first at 6.93 dx) leave it empty.
+            "bodies[1].shape",
+            Box::new(|v| {
+                v["bodies"][1]["shape"]["cylinder"]["inner_radius"] = json!(6.4 * R / 6.0);
+                v["bodies"][1]["shape"]["cylinder"]["radius"] = json!(6.92 * R / 6.0);
+            }),
+        ),
+        (
             // Rings fill a disc or a cylinder's cross-section, not a ball.
             "bodies[0].packing",
             Box::new(|v| {

@@ -283,7 +283,7 @@ pub struct Boundaries {
     /// Periodic axes (0 = x, 1 = y, 2 = z) with their period.
     #[serde(default)]
     pub periodic: Vec<PeriodicAxis>,
-    /// Plane no-slip walls (none: no wall stage is built).
+    /// Plane no-slip walls (none and no wall body: no wall stage is built).
     #[serde(default)]
     pub walls: Vec<Wall>,
     /// How walls are represented.
@@ -356,9 +356,10 @@ pub enum WallModel {
     /// own pressure; near a corner it is reflected across both walls too.
     #[default]
     Mirror,
-    /// Fixed dummy particles filling the kernel support behind each wall on the fluid's
-    /// lattice, with the generalised wall condition of Adami, Hu & Adams 2012: velocity
-    /// `−ũ` and pressure `(Σ p_f W + ρ g·Σ r_wf W)/Σ W` extrapolated from the fluid.
+    /// Fixed dummy particles filling the kernel support behind each wall plane on the
+    /// fluid's lattice, and the particles of every wall body (`role: wall`), with the
+    /// generalised wall condition of Adami, Hu & Adams 2012: velocity `−ũ` and pressure
+    /// `(Σ p_f W + ρ g·Σ r_wf W)/Σ W` extrapolated from the fluid. Wall bodies need it.
     Dummy,
 }
 

@@ -184,6 +184,10 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
 /// Largest particle count a scene may ask for (memory: about 1 kB per particle).
 const MAX_PARTICLES: f64 = 5e7;
 
+/// Largest cylinder radius over Δx: its cross-section is scanned on a `(2R/Δx)²` grid,
+/// about [`MAX_PARTICLES`] points at this radius.
+const MAX_CYLINDER_RADIUS_OVER_DX: f64 = 3500.0;
+
 /// Largest number of fixed steps (the adaptive step's floor, 1e-9 of the end time, gives
 /// the same bound): beyond it `t + Δt` would lose Δt to rounding.
 const MAX_STEPS: f64 = 1e9;
@@ -508,6 +512,16 @@ fn validate_body(f: &str, body: &Body, d: usize, dx: f64) -> Result<(), SceneErr
                     format!("{f}.inner_radius"),
                     inner_radius,
                     "must be finite and not negative",
+                ));
+            }
+            // The lattice cross-section scans a (2R/Δx)² grid whatever the shell's thickness.
+            if *radius > MAX_CYLINDER_RADIUS_OVER_DX * dx {
+                return Err(SceneError::new(
+                    format!("{f}.radius"),
+                    radius,
+                    format!(
+                        "must be at most {MAX_CYLINDER_RADIUS_OVER_DX} dx (its cross-section is seeded on a (2R/dx)^2 grid)"
+                    ),
                 ));
             }
             if *radius - *inner_radius < 0.5 * dx {

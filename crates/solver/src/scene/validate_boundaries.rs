@@ -1,4 +1,4 @@
-//! Value checks of walls, inflow/outflow, velocity profiles and probe times (split from `validate` to keep
+//! Value checks of walls, inflow/outflow, velocity and radial profiles and probe times (split from `validate` to keep
 //! each file about one part of the scene). Every rule names the field, the value and the
 //! rule.
 
@@ -103,6 +103,16 @@ pub(super) fn validate(scene: &Scene) -> Result<(), SceneError> {
                 "needs a circle in a 2D scene or a cylinder in a 3D scene (concentric rings fill a disc)",
             ));
         }
+        if let (Packing::Rings, Shape::Cylinder { inner_radius, .. }) = (body.packing, &body.shape)
+            && *inner_radius > 0.0
+            && *inner_radius < scene.dx
+        {
+            return Err(SceneError::new(
+                format!("bodies[{i}].shape.cylinder.inner_radius"),
+                inner_radius,
+                "must be 0 or at least dx with rings (the rings continue those of a disc of this radius)",
+            ));
+        }
         if body.packing == Packing::Shells && !(d == 3 && matches!(body.shape, Shape::Sphere { .. })) {
             return Err(SceneError::new(
                 format!("bodies[{i}].packing"),
@@ -188,6 +198,13 @@ fn open_boundaries(scene: &Scene) -> Result<(), SceneError> {
             "boundaries.inflow.axis",
             inflow.axis,
             "is also the normal of a wall (walls must run along the flow)",
+        ));
+    }
+    if let Some(i) = scene.bodies.iter().position(|body| body.role == Role::Wall) {
+        return Err(SceneError::new(
+            format!("bodies[{i}].role"),
+            "wall",
+            "is not supported with inflow/outflow yet (wall bodies are dummy particles; use mirror wall planes)",
         ));
     }
     if b.wall_model == WallModel::Dummy && scene.has_walls() {

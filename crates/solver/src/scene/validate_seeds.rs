@@ -19,7 +19,7 @@ pub fn validate_seeds(scene: &Scene) -> Result<(), SceneError> {
 }
 
 fn check<const D: usize>(scene: &Scene) -> Result<(), SceneError> {
-    wall_bodies(scene)?;
+    pipes_and_wall_bodies(scene)?;
     let mut seeds = seeding::seed_bodies::<D>(scene);
     if seeds.x.is_empty() {
         return Err(SceneError::new("bodies", scene.bodies.len(), "hold no fluid particle"));
@@ -63,10 +63,11 @@ fn check<const D: usize>(scene: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// The rules of wall bodies (`role: wall`): dummy particles at rest, so `wall_model` must
-/// be `dummy` and the body has no initial velocity, pressure or jitter; and a cylinder
-/// (a pipe's fluid, or the inside of its wall shell) wider than the kernel support.
-fn wall_bodies(scene: &Scene) -> Result<(), SceneError> {
+/// The rules of pipes and wall bodies: a cylinder (a pipe's fluid, or the inside of its
+/// wall shell) wider than the kernel support; wall bodies (`role: wall`) are dummy
+/// particles at rest, so `wall_model` must be `dummy` and the body has no initial velocity,
+/// pressure or jitter.
+fn pipes_and_wall_bodies(scene: &Scene) -> Result<(), SceneError> {
     let support = 2.0 * scene.h();
     for (i, body) in scene.bodies.iter().enumerate() {
         if let Shape::Cylinder { radius, inner_radius, .. } = body.shape {
@@ -119,10 +120,20 @@ fn wall_bodies(scene: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// Rejects a wall body whose particles come closer than Δx/2 to a fluid particle (`fluid`,
-/// seeded and wrapped, not jittered): a wall that overlaps the fluid.
+/// Rejects a wall body that holds no particle, and one whose particles come closer than
+/// Δx/2 to a fluid particle (`fluid`, seeded and wrapped, not jittered): a wall that
+/// overlaps the fluid.
 fn walls_clear_of_fluid<const D: usize>(scene: &Scene, fluid: &[Vector<D>]) -> Result<(), SceneError> {
     let walls = seeding::seed_walls::<D>(scene);
+    for (i, body) in scene.bodies.iter().enumerate() {
+        if body.role == Role::Wall && !walls.iter().any(|w| w.1 == i) {
+            return Err(SceneError::new(
+                format!("bodies[{i}].shape"),
+                "wall body",
+                "holds no particle at this dx",
+            ));
+        }
+    }
     if walls.is_empty() {
         return Ok(());
     }
@@ -142,7 +153,7 @@ fn walls_clear_of_fluid<const D: usize>(scene: &Scene, fluid: &[Vector<D>]) -> R
             format!("bodies[{body}].shape"),
             format!("a wall particle at ({})", show(&x)),
             format!(
-                "overlaps the fluid (within dx/2 of the fluid particle at ({})); a wall body must lie outside the fluid",
+                "overlaps the fluid (within dx/2 of the fluid particle at ({})); a wall body's particles must keep dx/2 from the fluid's",
                 show(&fluid[a])
             ),
         ));

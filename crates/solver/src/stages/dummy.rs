@@ -1,6 +1,7 @@
 //! Dummy-particle walls with the generalised wall boundary condition of Adami, Hu & Adams
-//! 2012 (J. Comput. Phys. 231:7057, eqs. 22–23, 27): fixed layers of wall particles behind
-//! each wall plane whose velocity and pressure are extrapolated from the fluid every step.
+//! 2012 (J. Comput. Phys. 231:7057, eqs. 22–23, 27): fixed wall particles (layers behind
+//! each wall plane, [`dummy_layers`], and the particles of wall bodies of any shape) whose
+//! velocity and pressure are extrapolated from the fluid every step.
 //!
 //! - velocity (no slip, eqs. 22–23): `u_w = 2 u_wall − ũ_w`, `ũ_w = Σ_f u_f W_wf / Σ_f W_wf`
 //!   (walls at rest: `u_wall = 0`);
