@@ -26,11 +26,7 @@ pub fn particle_state<const D: usize>(scene: &Scene, h: f64, support: f64) -> (S
     let buffer = particles.total() - particles.fluid;
     if scene.boundaries.wall_model == WallModel::Dummy && scene.has_walls() {
         let depth = 2.0 * scene.h();
-        let planes = if scene.boundaries.walls.is_empty() {
-            Vec::new()
-        } else {
-            dummy_layers(&scene.boundaries.walls, &domain, &particles.x, scene.dx, depth)
-        };
+        let planes = dummy_layers(&scene.boundaries.walls, &domain, &particles.x, scene.dx, depth);
         let bodies = seeding::seed_walls::<D>(scene).into_iter().map(|(x, _)| x);
         for x in planes.into_iter().chain(bodies) {
             particles.x.push(x);

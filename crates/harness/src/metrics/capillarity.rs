@@ -175,20 +175,10 @@ pub fn dimension(scene: &serde_json::Value) -> Result<Dimension, ReferenceError>
     }
 }
 
-/// Computes the metrics and series of one run of a 2D drop: [`compute_in`] with
-/// [`Dimension::Two`].
-pub fn compute(case: &Capillary, probes: &ProbeRecord) -> Result<Measured, ReferenceError> {
-    compute_in(Dimension::Two, case, probes)
-}
-
 /// Computes the metrics and series of one run of a drop in `dim` (the module docs give the
 /// probe and the reference formula read in each dimension). The square drop is 2D only: in
 /// 3D it is an error.
-pub fn compute_in(
-    dim: Dimension,
-    case: &Capillary,
-    probes: &ProbeRecord,
-) -> Result<Measured, ReferenceError> {
+pub fn compute(dim: Dimension, case: &Capillary, probes: &ProbeRecord) -> Result<Measured, ReferenceError> {
     if dim == Dimension::Three && matches!(case, Capillary::Square { .. }) {
         return Err(ReferenceError::InvalidParameter {
             name: "dimension",
@@ -332,7 +322,9 @@ mod tests {
         let a: Vec<f64> = d.iter().map(|x| 0.2 + x / 2.0).collect();
         let b: Vec<f64> = d.iter().map(|x| 0.2 - x / 2.0).collect();
         let r = record(&t, &[("ellipse_axes", "a_moment", a), ("ellipse_axes", "b_moment", b)]);
-        let m = compute(&Capillary::Oscillating { radius, sigma, density, nu }, &r).unwrap().metrics;
+        let m = compute(Dimension::Two, &Capillary::Oscillating { radius, sigma, density, nu }, &r)
+            .unwrap()
+            .metrics;
         assert!(m["period_rel_err"] < 1e-3, "{m:?}");
         assert!(m["damping_rel_err"] < 0.05, "{m:?}");
         // A 10 % slower oscillation is measured as such.
@@ -341,7 +333,9 @@ mod tests {
             &t,
             &[("ellipse_axes", "a_moment", d2.clone()), ("ellipse_axes", "b_moment", vec![0.0; 4000])],
         );
-        let m2 = compute(&Capillary::Oscillating { radius, sigma, density, nu }, &r2).unwrap().metrics;
+        let m2 = compute(Dimension::Two, &Capillary::Oscillating { radius, sigma, density, nu }, &r2)
+            .unwrap()
+            .metrics;
         assert!((m2["period_rel_err"] - 0.1).abs() < 2e-3, "{m2:?}");
     }
 
@@ -376,7 +370,7 @@ mod tests {
         let p: Vec<f64> = t.iter().map(|x| if *x < 0.75 { 0.0 } else { 5.25 }).collect();
         let u = vec![1e-3; t.len()];
         let r = record(&t, &[("pressure_at", "p", p), ("max_speed", "u_max", u)]);
-        let m = compute(&Capillary::Static { radius: 0.2, sigma: 1.0 }, &r).unwrap().metrics;
+        let m = compute(Dimension::Two, &Capillary::Static { radius: 0.2, sigma: 1.0 }, &r).unwrap().metrics;
         assert!((m["dp_rel_err_late"] - 0.05).abs() < 1e-12, "{m:?}");
         assert!((m["u_spurious_max_late"] - 1e-3).abs() < 1e-15);
     }
@@ -397,7 +391,7 @@ mod tests {
                 ("max_speed", "u_rms", vec![5e-4; t.len()]),
             ],
         );
-        let m = compute_in(Dimension::Three, &case, &r).unwrap().metrics;
+        let m = compute(Dimension::Three, &case, &r).unwrap().metrics;
         assert!(m["dp_rel_err_late"].abs() < 1e-12 && m["dp_rel_err_final"].abs() < 1e-12, "{m:?}");
         assert!((m["dp_late"] - jump).abs() < 1e-12, "{m:?}");
         assert!(
@@ -406,13 +400,13 @@ mod tests {
         );
         // 5 % above 2σ/R: a 5 % error (in 2D the same series would be 110 % off σ/R).
         let r = record(&t, &[("mean_pressure", "p", vec![1.05 * jump; t.len()])]);
-        let m = compute_in(Dimension::Three, &case, &r).unwrap().metrics;
+        let m = compute(Dimension::Three, &case, &r).unwrap().metrics;
         assert!((m["dp_rel_err_late"] - 0.05).abs() < 1e-12 && (m["dp_rel_err_final"] - 0.05).abs() < 1e-12);
-        let m2 = compute_in(Dimension::Two, &case, &r).unwrap().metrics;
+        let m2 = compute(Dimension::Two, &case, &r).unwrap().metrics;
         assert!((m2["dp_rel_err_late"] - 1.1).abs() < 1e-12, "{m2:?}");
         // With only `pressure_at`, the 3D drop reads it.
         let r = record(&t, &[("pressure_at", "p", vec![0.95 * jump; t.len()])]);
-        let m = compute_in(Dimension::Three, &case, &r).unwrap().metrics;
+        let m = compute(Dimension::Three, &case, &r).unwrap().metrics;
         assert!((m["dp_rel_err_late"] - 0.05).abs() < 1e-12, "{m:?}");
     }
 
@@ -425,10 +419,9 @@ mod tests {
             &[("pressure_at", "p", vec![6.0; t.len()]), ("mean_pressure", "p", vec![5.0; t.len()])],
         );
         let case = Capillary::Static { radius: 0.2, sigma: 1.0 };
-        let m = compute(&case, &r).unwrap();
+        let m = compute(Dimension::Two, &case, &r).unwrap();
         assert!(m.metrics["dp_rel_err_late"].abs() < 1e-12, "{:?}", m.metrics);
         assert_eq!(m.series["p"], vec![5.0; t.len()]);
-        assert_eq!(compute_in(Dimension::Two, &case, &r).unwrap(), m);
     }
 
     #[test]
@@ -454,7 +447,7 @@ mod tests {
             ],
         );
         let case = Capillary::Oscillating { radius, sigma, density, nu };
-        let out = compute_in(Dimension::Three, &case, &r).unwrap();
+        let out = compute(Dimension::Three, &case, &r).unwrap();
         let m = &out.metrics;
         assert!((m["period_ref"] / t3 - 1.0).abs() < 1e-12, "{m:?}");
         assert!(m["period_rel_err"] < 1e-3, "{m:?}");
@@ -468,10 +461,10 @@ mod tests {
             &t,
             &[("ellipse_axes", "a_moment", d.clone()), ("ellipse_axes", "b_moment", vec![0.0; 4000])],
         );
-        let m2 = compute_in(Dimension::Three, &case, &r2).unwrap().metrics;
+        let m2 = compute(Dimension::Three, &case, &r2).unwrap().metrics;
         assert!(!m2.contains_key("period") && !m2.contains_key("damping_rel_err"), "{m2:?}");
         // The same signal judged as 2D is off by the ratio of the periods, √(8/6) − 1.
-        let m3 = compute_in(Dimension::Two, &case, &r2).unwrap().metrics;
+        let m3 = compute(Dimension::Two, &case, &r2).unwrap().metrics;
         let t2 = t3 * (8.0_f64 / 6.0).sqrt();
         assert!((m3["period_rel_err"] - (1.0 - t3 / t2)).abs() < 2e-3, "{m3:?}");
     }
@@ -488,7 +481,7 @@ mod tests {
         // The square drop has no 3D metrics.
         let r = record(&[0.0, 1.0], &[]);
         let square = Capillary::Square { side: 0.2, sigma: 1.0, density: 1.0 };
-        assert!(compute_in(Dimension::Three, &square, &r).is_err());
-        assert!(compute_in(Dimension::Two, &square, &r).is_ok());
+        assert!(compute(Dimension::Three, &square, &r).is_err());
+        assert!(compute(Dimension::Two, &square, &r).is_ok());
     }
 }

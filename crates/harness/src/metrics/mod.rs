@@ -56,18 +56,18 @@ pub fn compute(
         // the scene.
         ReferenceSpec::StaticDrop { radius, sigma } => {
             let dim = capillarity::dimension(scene)?;
-            capillarity::compute_in(dim, &capillarity::Capillary::Static { radius, sigma }, probes)?
+            capillarity::compute(dim, &capillarity::Capillary::Static { radius, sigma }, probes)?
         }
         ReferenceSpec::OscillatingDrop { radius, sigma, density } => {
             let dim = capillarity::dimension(scene)?;
             let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
             let nu = num(&scene["fluid"]["viscosity"]) / num(&scene["fluid"]["density"]);
             let case = capillarity::Capillary::Oscillating { radius, sigma, density, nu };
-            capillarity::compute_in(dim, &case, probes)?
+            capillarity::compute(dim, &case, probes)?
         }
         ReferenceSpec::SquareDrop { side, sigma, density } => {
             let dim = capillarity::dimension(scene)?;
-            capillarity::compute_in(dim, &capillarity::Capillary::Square { side, sigma, density }, probes)?
+            capillarity::compute(dim, &capillarity::Capillary::Square { side, sigma, density }, probes)?
         }
     };
     m.metrics.insert("particles".into(), particles as f64);

@@ -65,8 +65,7 @@ pub fn seed_walls<const D: usize>(scene: &Scene) -> Vec<(SVector<f64, D>, usize)
     let domain = domain::<D>(scene);
     let mut out = Vec::new();
     for (i, body) in scene.bodies.iter().enumerate().filter(|(_, b)| b.role == Role::Wall) {
-        for x in lattice::seed_points::<D>(body, scene.dx) {
-            let mut x = x;
+        for mut x in lattice::seed_points::<D>(body, scene.dx) {
             domain.wrap(&mut x);
             out.push((x, i));
         }

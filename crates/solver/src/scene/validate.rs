@@ -154,23 +154,16 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
             vector(&format!("probes[{i}].mean_pressure.center"), center, d)?;
             positive(&format!("probes[{i}].mean_pressure.radius"), *radius)?;
         }
-        if let Probe::EllipsoidAxes {} = probe
-            && d != 3
+        // Shape probes of one dimension: the ellipse in 2D, the ellipsoid in 3D.
+        let only = match probe {
+            Probe::EllipseAxes {} => Some((2, "is defined for 2D scenes only")),
+            Probe::EllipsoidAxes {} => Some((3, "is defined for 3D scenes only (ellipse_axes in 2D)")),
+            _ => None,
+        };
+        if let Some((want, rule)) = only
+            && d != want
         {
-            return Err(SceneError::new(
-                format!("probes[{i}].ellipsoid_axes"),
-                "{}",
-                "is defined for 3D scenes only (ellipse_axes in 2D)",
-            ));
-        }
-        if let Probe::EllipseAxes {} = probe
-            && d != 2
-        {
-            return Err(SceneError::new(
-                format!("probes[{i}].ellipse_axes"),
-                "{}",
-                "is defined for 2D scenes only",
-            ));
+            return Err(SceneError::new(format!("probes[{i}].{}", probe.kind_name()), "{}", rule));
         }
     }
     if scene.output.probe_every == 0 {
@@ -491,14 +484,12 @@ fn validate_body(f: &str, body: &Body, d: usize, dx: f64) -> Result<(), SceneErr
             }
             positive(&format!("{f}.radius"), *radius)?;
             positive(&format!("{f}.length"), *length)?;
-            for (name, v) in [("radius", *radius), ("length", *length)] {
-                if v > MAX_COORDINATE_OVER_DX * dx {
-                    return Err(SceneError::new(
-                        format!("{f}.{name}"),
-                        v,
-                        "must be at most 1e9 dx (double precision cannot resolve the particle spacing)",
-                    ));
-                }
+            if *length > MAX_COORDINATE_OVER_DX * dx {
+                return Err(SceneError::new(
+                    format!("{f}.length"),
+                    length,
+                    "must be at most 1e9 dx (double precision cannot resolve the particle spacing)",
+                ));
             }
             if *length < dx * (1.0 - 1e-9) {
                 return Err(SceneError::new(

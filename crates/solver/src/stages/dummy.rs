@@ -33,7 +33,7 @@ pub fn dummy_layers<const D: usize>(
     dx: f64,
     depth: f64,
 ) -> Vec<Vector<D>> {
-    let Some(anchor) = fluid.first() else { return Vec::new() };
+    let Some(anchor) = fluid.first().filter(|_| !walls.is_empty()) else { return Vec::new() };
     let mut lo = Vector::<D>::repeat(f64::INFINITY);
     let mut hi = Vector::<D>::repeat(f64::NEG_INFINITY);
     for x in fluid {
