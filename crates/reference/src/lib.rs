@@ -14,6 +14,7 @@
 //! | [`entrance_flow`] | developing channel flow from a uniform inlet, Bodoia & Osterle 1961 (§3c) |
 //! | [`pipe`] | Hagen–Poiseuille pipe flow, steady and start-up (§3d) |
 //! | [`capillarity`] | Laplace pressure, capillary oscillation and damping of drops (§4) |
+//! | [`impact`] | drop impact on a wall: early spreading, maximum spread correlations (CASES.md) |
 //! | [`taylor_green`] | 2D periodic Taylor–Green vortex |
 
 pub mod capillarity;
@@ -21,6 +22,7 @@ pub mod elliptical_drop;
 pub mod entrance_flow;
 pub mod entrance_length;
 mod error;
+pub mod impact;
 pub mod pipe;
 pub mod poiseuille;
 pub mod rotating_square;
