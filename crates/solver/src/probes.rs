@@ -259,6 +259,13 @@ impl<const D: usize> ProbeSet<D> {
                     let r_max = x.iter().map(|p| (p - c).norm()).fold(0.0, f64::max);
                     out.push(key, "r_max", r_max);
                 }
+                Probe::Spread { axis, position, layer } => {
+                    let (diameter, width, height) =
+                        spread(x, *axis, *position, layer.unwrap_or(1.5 * s.dx), s.dx);
+                    out.push(key, "diameter", diameter);
+                    out.push(key, "width", width);
+                    out.push(key, "height", height);
+                }
                 Probe::Solver {} => {
                     out.push(
                         key,
@@ -278,6 +285,37 @@ impl<const D: usize> ProbeSet<D> {
 /// Largest |v| over `values`, NaN if any is NaN (`f64::max` would skip it), 0 when empty.
 fn largest_magnitude(values: &[f64]) -> f64 {
     values.iter().map(|v| v.abs()).fold(0.0, |m, v| if v > m || v.is_nan() { v } else { m })
+}
+
+/// The `spread` probe's (contact diameter, spread width, height) \[m\] of the particles
+/// `x` above the plane `x[axis] = position` (see [`Probe::Spread`]); zeros when none is.
+fn spread<const D: usize>(
+    x: &[Vector<D>],
+    axis: usize,
+    position: f64,
+    layer: f64,
+    dx: f64,
+) -> (f64, f64, f64) {
+    let above = || x.iter().filter(|p| p[axis] > position);
+    let n = above().count();
+    if n == 0 {
+        return (0.0, 0.0, 0.0);
+    }
+    let mut c: Vector<D> = above().sum::<Vector<D>>() / n as f64;
+    c[axis] = 0.0;
+    let (mut contact, mut all, mut top) = (f64::NEG_INFINITY, 0.0f64, 0.0f64);
+    for p in above() {
+        let mut r = p - c;
+        r[axis] = 0.0;
+        let (rho, s) = (r.norm(), p[axis] - position);
+        all = all.max(rho);
+        top = top.max(s);
+        if s <= layer {
+            contact = contact.max(rho);
+        }
+    }
+    let diameter = if contact.is_finite() { 2.0 * (contact + 0.5 * dx) } else { 0.0 };
+    (diameter, 2.0 * (all + 0.5 * dx), top + 0.5 * dx)
 }
 
 /// Smallest pair distance \[m\] (Δx when no pair is closer) and the fraction of particles
@@ -320,4 +358,41 @@ fn count_clusters(list: &NeighbourList, n: usize, parent: &mut Vec<u32>) -> usiz
         }
     }
     (0..n).filter(|&a| root(parent, a) == a).count()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A puddle on the plane z = 0: a one-row disc of particles at z = Δx/2 (lattice points
+    /// within 5 Δx of the axis) under a column rising to z = 6.5 Δx, above a film row at
+    /// z = −Δx/2 that the probe leaves out. The diameter and width add Δx/2 to the outermost
+    /// centre, the height Δx/2 to the top one.
+    #[test]
+    fn spread_of_a_puddle_and_its_column() {
+        let dx = 0.1;
+        let mut x: Vec<Vector<3>> = Vec::new();
+        for i in -8..=8 {
+            for j in -8..=8 {
+                let (px, py) = (i as f64 * dx, j as f64 * dx);
+                if px.hypot(py) <= 5.0 * dx + 1e-12 {
+                    x.push(Vector::<3>::new(px, py, 0.5 * dx));
+                }
+                x.push(Vector::<3>::new(px, py, -0.5 * dx));
+            }
+        }
+        for k in 1..=6 {
+            x.push(Vector::<3>::new(0.0, 0.0, (k as f64 + 0.5) * dx));
+        }
+        let (diameter, width, height) = spread(&x, 2, 0.0, 1.5 * dx, dx);
+        assert!((diameter - 2.0 * 5.5 * dx).abs() < 1e-12, "{diameter}");
+        assert!((width - diameter).abs() < 1e-12 && (height - 7.0 * dx).abs() < 1e-12, "{width} {height}");
+        // A lamella lifted off the plane at the rim widens the width, not the diameter.
+        x.push(Vector::<3>::new(7.0 * dx, 0.0, 2.5 * dx));
+        x.push(Vector::<3>::new(-7.0 * dx, 0.0, 2.5 * dx));
+        let (d2, w2, _) = spread(&x, 2, 0.0, 1.5 * dx, dx);
+        assert!((d2 - diameter).abs() < 1e-12 && w2 > diameter + 2.0 * dx, "{d2} {w2}");
+        // Nothing above the plane: zeros, not NaN.
+        assert_eq!(spread(&x, 2, 10.0, dx, dx), (0.0, 0.0, 0.0));
+    }
 }

@@ -935,6 +935,25 @@ pub enum Probe {
         #[serde(default)]
         bins: Option<usize>,
     },
+    /// Spreading of drops on a plane (an impact on a wall or a film; Xu 2016 §3.2–3.3): of
+    /// the fluid on the positive side of the plane `x[axis] = position` (centres with
+    /// `s = x[axis] − position > 0`), about the axis through its in-plane centroid,
+    /// `diameter` = 2 (largest in-plane distance ρ of a particle with `s ≤ layer` + Δx/2),
+    /// the wetted (contact) diameter \[m\]; `width` = 2 (largest ρ + Δx/2) over all of it,
+    /// the spread width seen from above (a lamella lifted off the plane counts) \[m\];
+    /// `height` = largest `s` + Δx/2 \[m\]. Each particle stands for a cell of side Δx, so
+    /// Δx/2 is the fluid's extent beyond the outermost centre. Zero when no fluid qualifies.
+    Spread {
+        /// The plane's normal axis (2 = z in 3D, 1 = y in 2D).
+        axis: usize,
+        /// The plane's position on `axis` \[m\]: the wall's surface, or a film's.
+        position: f64,
+        /// Thickness of the contact layer \[m\] (absent: 1.5 Δx, the first row of particles:
+        /// a dummy wall holds it about one spacing off the plane, measured on
+        /// `droplet_impact`).
+        #[serde(default)]
+        layer: Option<f64>,
+    },
 }
 
 /// A slab `range[0] <= x[axis] <= range[1]`.
@@ -1016,6 +1035,7 @@ impl Probe {
             Probe::MassBalance {} => "mass_balance",
             Probe::MaxSpeed {} => "max_speed",
             Probe::DropShape {} => "drop_shape",
+            Probe::Spread { .. } => "spread",
         }
     }
 }

@@ -154,6 +154,20 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
             vector(&format!("probes[{i}].mean_pressure.center"), center, d)?;
             positive(&format!("probes[{i}].mean_pressure.radius"), *radius)?;
         }
+        if let Probe::Spread { axis, position, layer } = probe {
+            let key = format!("probes[{i}].spread");
+            if *axis >= d {
+                return Err(SceneError::new(
+                    format!("{key}.axis"),
+                    axis,
+                    format!("must be below the dimension {d}"),
+                ));
+            }
+            finite(&format!("{key}.position"), *position)?;
+            if let Some(layer) = layer {
+                positive(&format!("{key}.layer"), *layer)?;
+            }
+        }
         // Shape probes of one dimension: the ellipse in 2D, the ellipsoid in 3D.
         let only = match probe {
             Probe::EllipseAxes {} => Some((2, "is defined for 2D scenes only")),
