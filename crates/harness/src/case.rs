@@ -237,6 +237,16 @@ pub enum ReferenceSpec {
         /// Density \[kg/m^3\].
         density: f64,
     },
+    /// A drop of diameter D hitting a plane at speed V at t = 0
+    /// (`meniscus_reference::impact`): the `spread` probe's wetted diameter against `√(6T)`
+    /// early and the published `β_max` correlations; the liquid's ρ, μ, σ come from each
+    /// run's scene.
+    DropletImpact {
+        /// Drop diameter D \[m\].
+        diameter: f64,
+        /// Impact speed V \[m/s\].
+        speed: f64,
+    },
     /// A 2D square of side L relaxing to a circle of radius `L/√π`: Laplace pressure,
     /// connectivity, circularity and the mode-4 period.
     SquareDrop {

@@ -6,6 +6,7 @@
 //! { "kind": "decreasing", "metric": "b_rel_err_max", "over": "dx", "select": { "preset": "paper" } }
 //! { "kind": "equals", "metric": "particles", "select": { "dx": 0.04 }, "value": 1976 }
 //! { "kind": "order", "metric": "u_profile_l2_rel", "select": { "preset": "paper" }, "min": 1.0 }
+//! { "kind": "finest_change", "metric": "beta_max", "select": { "preset": "xu" }, "max": 0.05 }
 //! { "metric": "pc_rel_err_final", "select": { "preset": "wcsph_paper" }, "max": 0.1, "expected_failure": "why" }
 //! ```
 //! A check with `expected_failure` (the published scheme's documented shortfall) is a strict
@@ -54,6 +55,10 @@ pub enum CheckKind {
     Decreasing,
     /// The observed order in dx (least squares in log-log) is at least `min`.
     Order,
+    /// A quantity that has no reference value settles: its relative change between the two
+    /// finest spacings (per scheme and preset), `|m(finest) − m(next)| / |m(next)|`, is at
+    /// most `max`.
+    FinestChange,
 }
 
 /// A row a check can select and read: a case's run, or a row of a study (the stability
@@ -203,6 +208,12 @@ impl CheckSpec {
             Some(CheckKind::Equals) => format!("{m}{sel} = {}", self.value.unwrap_or(f64::NAN)),
             Some(CheckKind::Decreasing) => format!("{m}{sel} decreases with dx"),
             Some(CheckKind::Order) => format!("order of {m}{sel} ≥ {}", self.min.unwrap_or(f64::NAN)),
+            Some(CheckKind::FinestChange) => {
+                format!(
+                    "{m}{sel} changes by ≤ {} between the two finest spacings",
+                    self.max.unwrap_or(f64::NAN)
+                )
+            }
             None => format!("{m}{sel}"),
         }
     }
@@ -210,7 +221,7 @@ impl CheckSpec {
     /// The bound the value is compared with (`decreasing`: 1, the largest allowed ratio).
     pub fn threshold(&self) -> Option<f64> {
         match self.kind()? {
-            CheckKind::Max => self.max,
+            CheckKind::Max | CheckKind::FinestChange => self.max,
             CheckKind::Min | CheckKind::Order => self.min,
             CheckKind::Equals => self.value,
             CheckKind::Decreasing => Some(1.0),
@@ -239,6 +250,7 @@ impl CheckSpec {
             Some(CheckKind::Max) => need(self.max, "max", "max"),
             Some(CheckKind::Min) => need(self.min, "min", "min"),
             Some(CheckKind::Order) => need(self.min, "min", "order"),
+            Some(CheckKind::FinestChange) => need(self.max, "max", "finest_change"),
             Some(CheckKind::Equals) => need(self.value, "value", "equals"),
             Some(CheckKind::Decreasing) => match self.over.as_deref() {
                 None | Some("dx") => Ok(()),
@@ -292,6 +304,7 @@ impl CheckSpec {
             }
             CheckKind::Decreasing => decreasing(&name, &selected, &self.metric)?,
             CheckKind::Order => order(&name, &selected, &self.metric, self.min?)?,
+            CheckKind::FinestChange => finest_change(&name, &selected, &self.metric, self.max?)?,
         };
         if !diverged.is_empty() {
             result.pass = false;
@@ -478,6 +491,35 @@ fn order(name: &str, runs: &[&RunResult], metric: &str, min: f64) -> Option<Chec
     })
 }
 
+/// `finest_change`: the largest relative change of `metric` between the two finest spacings
+/// of each (scheme, preset) against `max`; not applicable with fewer than two spacings.
+fn finest_change(name: &str, runs: &[&RunResult], metric: &str, max: f64) -> Option<CheckResult> {
+    let mut worst: Option<f64> = None;
+    let mut note = None;
+    for ((scheme, preset), pts) in &by_group(runs, metric) {
+        let [.., (_, coarse), (_, fine)] = pts.as_slice() else { continue };
+        match (coarse, fine) {
+            (Some(c), Some(f)) => {
+                let change = ((f - c) / c).abs();
+                let change = if change.is_nan() { f64::INFINITY } else { change };
+                worst = Some(worst.map_or(change, |w| w.max(change)));
+            }
+            _ => note = Some(format!("`{metric}` missing or not finite in {scheme}-{preset}")),
+        }
+    }
+    if worst.is_none() && note.is_none() {
+        return None;
+    }
+    Some(CheckResult {
+        name: name.to_string(),
+        value: worst,
+        threshold: Some(max),
+        pass: note.is_none() && worst.is_some_and(|w| w <= max),
+        note,
+        expected_failure: None,
+    })
+}
+
 /// Evaluates every applicable check of a case.
 pub fn evaluate_all<R: Checked>(specs: &[CheckSpec], runs: &[R], tier: Tier) -> Vec<CheckResult> {
     specs.iter().filter_map(|c| c.evaluate(runs, tier)).collect()
@@ -588,6 +630,31 @@ mod tests {
         assert!(r.note.as_deref().is_some_and(|n| n.contains("2 of 3 spacings")), "{:?}", r.note);
         three[1].metrics.insert("b_rel_err_max".into(), f64::NAN);
         assert!(!order.evaluate(&three, Tier::Quick).unwrap().pass, "a NaN point");
+    }
+
+    /// `finest_change` compares the two finest spacings of each preset only: three spacings
+    /// whose coarsest is far off pass when the finest two agree; a NaN or a single spacing
+    /// does not.
+    #[test]
+    fn finest_change_judges_the_two_finest_spacings() {
+        let mut rows = vec![
+            run("paper", 0.04, 0.5, 1976, "ok"),
+            run("paper", 0.02, 0.0100, 7860, "ok"),
+            run("paper", 0.01, 0.0104, 31000, "ok"),
+        ];
+        let c = spec(json!({"kind": "finest_change", "metric": "b_rel_err_max", "max": 0.05}));
+        let r = c.evaluate(&rows, Tier::Quick).unwrap();
+        assert!(r.pass && (r.value.unwrap() - 0.04).abs() < 1e-12, "{r:?}");
+        assert!(r.name.contains("two finest"), "{}", r.name);
+        let tight = spec(json!({"kind": "finest_change", "metric": "b_rel_err_max", "max": 0.03}));
+        assert!(!tight.evaluate(&rows, Tier::Quick).unwrap().pass);
+        rows[2].metrics.insert("b_rel_err_max".into(), f64::NAN);
+        let r = c.evaluate(&rows, Tier::Quick).unwrap();
+        assert!(!r.pass && r.note.is_some(), "{r:?}");
+        assert!(c.evaluate(&rows[..1], Tier::Quick).is_none(), "one spacing: not applicable");
+        let no_bound: CheckSpec =
+            serde_json::from_value(json!({"kind": "finest_change", "metric": "m"})).unwrap();
+        assert!(no_bound.validate().unwrap_err().contains("max"));
     }
 
     #[test]

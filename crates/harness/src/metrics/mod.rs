@@ -9,6 +9,7 @@
 pub mod capillarity;
 pub mod channel;
 pub mod elliptical_drop;
+pub mod impact;
 pub mod poiseuille;
 pub mod rotating_square;
 
@@ -64,6 +65,9 @@ pub fn compute(
             let nu = num(&scene["fluid"]["viscosity"]) / num(&scene["fluid"]["density"]);
             let case = capillarity::Capillary::Oscillating { radius, sigma, density, nu };
             capillarity::compute(dim, &case, probes)?
+        }
+        ReferenceSpec::DropletImpact { diameter, speed } => {
+            impact::compute(&impact::Params::new(diameter, speed, scene), probes)?
         }
         ReferenceSpec::SquareDrop { side, sigma, density } => {
             let dim = capillarity::dimension(scene)?;
