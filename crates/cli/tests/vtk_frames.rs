@@ -83,11 +83,37 @@ fn json_f64s(v: &serde_json::Value) -> Vec<f64> {
 
 #[test]
 fn frames_read_back_as_the_snapshots_at_the_same_steps() {
-    let dir = scratch("frames");
     let mut scene: serde_json::Value = serde_json::from_str(DROP).expect("scene JSON");
     scene["dx"] = serde_json::json!(0.1);
     scene["time"]["end"] = serde_json::json!(6e-5);
     scene["output"]["snapshot_times"] = serde_json::json!([0.0, 4e-5]);
+    frames_match_snapshots("frames", &scene);
+}
+
+/// A 3D run's frames (a falling WCSPH ball of spherical shells with Hu–Adams surface
+/// tension) read back as its snapshots: three coordinates and velocity components a point.
+#[test]
+fn frames_of_a_3d_run_read_back_as_its_snapshots() {
+    let scene = serde_json::json!({
+        "name": "ball", "dimension": 3, "dx": 0.25,
+        "kernel": { "kind": "cubic_spline", "h_over_dx": 1.5 },
+        "fluid": { "density": 1000.0, "viscosity": 1e-3, "surface_tension": 0.07 },
+        "body_force": [0.0, 0.0, -9.81],
+        "bodies": [{ "role": "fluid", "shape": { "sphere": { "center": [0.0, 0.0, 0.0], "radius": 1.2 } },
+                     "packing": "shells",
+                     "velocity": { "affine": { "gradient": [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, -0.2]],
+                                               "offset": [0.0, 0.0, -1.0] } } }],
+        "scheme": { "wcsph": { "sound_speed": 20.0 } },
+        "time": { "end": 0.01, "step": { "adaptive": { "cfl": 0.25, "viscous": 0.2, "max": 1e-3 } } },
+        "output": { "snapshot_times": [0.0, 0.005] }
+    });
+    frames_match_snapshots("frames_3d", &scene);
+}
+
+/// Runs `scene` with a frame every step and compares the frames at the snapshots' steps with
+/// the snapshots.
+fn frames_match_snapshots(name: &str, scene: &serde_json::Value) {
+    let dir = scratch(name);
     let scene_path = dir.join("scene.json");
     std::fs::write(&scene_path, scene.to_string()).unwrap();
     let out = dir.join("out");
@@ -116,6 +142,7 @@ fn frames_read_back_as_the_snapshots_at_the_same_steps() {
         let frame = Frame::read(&out.join(format!("frames/frame_{step:06}.vtu")));
         let n = snap["p"].as_array().unwrap().len();
         assert!(n > 100, "{n} particles");
+        assert_eq!(frame.points.len(), 3 * n, "three coordinates a point");
         assert_eq!(frame.types, vec![CellType::Vertex; n]);
         assert_close(&frame.points, &json_f64s(&snap["x"]), "positions");
         assert_close(&frame.f64s("velocity"), &json_f64s(&snap["u"]), "velocity");
