@@ -16,7 +16,10 @@
 //! (`results.json` is also rewritten, marked incomplete, after every run, so an interrupted
 //! study keeps what it measured). The channel's runs follow the drop's and are recorded in
 //! the `channel` field of `results.json`, with their own Pareto fronts and figure (an MPS
-//! point beside the ISPH option sets); the targets are the drop's ISPH presets'.
+//! point beside the ISPH option sets); the targets are the drop's ISPH presets'. Last, the
+//! 3D pipe's ISPH and WCSPH presets ([`pipe`], the `pipe` field) add particle-steps per
+//! second and each run's peak memory, in bytes and per particle, with their own table and
+//! figure.
 //!
 //! Reuse: every run's record is cached in `<out>/runs/<id>.json`, but a study measures
 //! every run again by default, so that all its times come from one invocation under one
@@ -30,6 +33,7 @@ pub mod costs;
 pub mod design;
 pub mod page;
 pub mod pareto;
+pub mod pipe;
 pub mod plots;
 pub mod record;
 pub mod targets;
@@ -89,9 +93,11 @@ fn job(case: &Case, id: String, dx: f64, scene: meniscus::Scene, threads: usize)
 pub fn run(opts: &Options) -> Result<Study> {
     let case = Case::load(&opts.validation_dir.join(format!("{CASE}.json")))?;
     let channel_case = Case::load(&opts.validation_dir.join(format!("{}.json", channel::CASE)))?;
+    let pipe_case = Case::load(&opts.validation_dir.join(format!("{}.json", pipe::CASE)))?;
     let threads = opts.threads.max(1);
     let design = Design::for_tier(opts.tier, threads);
     let (channel_runs, channel_design) = channel::design(opts.tier, threads);
+    let (pipe_runs, pipe_design) = pipe::design(&pipe_case, opts.tier, threads)?;
     let mut provenance = Provenance::collect(&opts.workspace);
     provenance.threads = threads;
     let study = Mutex::new(Study {
@@ -116,10 +122,11 @@ pub fn run(opts: &Options) -> Result<Study> {
         speedups: Vec::new(),
         targets: Vec::new(),
         channel: Some(ChannelStudy::new(channel_design)),
+        pipe: Some(pipe::PipeStudy::new(pipe_design)),
         scheme_costs: Vec::new(),
     });
     let start = Instant::now();
-    let total = design.runs.len() + channel_runs.len();
+    let total = design.runs.len() + channel_runs.len() + pipe_runs.len();
     let progress = if opts.progress { Progress::new(true) } else { Progress::silent() };
     let runner = Runner::new(progress, !opts.resume, 1);
     // One line per run, and results.json rewritten with the run's row.
@@ -170,6 +177,18 @@ pub fn run(opts: &Options) -> Result<Study> {
         let line = record(design.runs.len() + i, &row.id, &row.cost, error, status, row.reused, &add)?;
         Ok(((), line))
     })?;
+    // The pipe's runs one batch each, so that the process's peak memory during a batch is
+    // its run's.
+    for (i, planned) in pipe_runs.iter().enumerate() {
+        pipe::run(&runner, &opts.out, &pipe_case, planned, |row| {
+            let status = if row.ok() { "ok" } else { &row.status };
+            let memory = row.bytes_per_particle.map_or("—".into(), |b| format!("{b:.0} B/particle"));
+            let error = format!("profile err {:>9}  {memory}", pct(row.error));
+            let add = |s: &mut Study| s.pipe.iter_mut().for_each(|p| p.runs.push(row.clone()));
+            let i = design.runs.len() + channel_runs.len() + i;
+            record(i, &row.id, &row.cost, error, status, row.reused, &add)
+        })?;
+    }
     let mut study = study.into_inner().unwrap_or_else(|e| e.into_inner());
     study.elapsed_s = start.elapsed().as_secs_f64();
     study.machine.loadavg_end = loadavg();
@@ -332,6 +351,14 @@ pub fn figures(study: &Study) -> Result<Vec<page::Figure>> {
                 "Periodic channel (Re = 4, to τ = νt/D² = 1): wall time against the steady profile error, every finished run with {} threads: colour the spacing, marker the scheme (disc ISPH, cross MPS); the black lines join each scheme's Pareto front.",
                 study.threads
             ),
+        });
+    }
+    if let Some(p) = study.pipe.as_ref().filter(|p| !p.runs.is_empty()) {
+        let rows: Vec<&pipe::PipeRow> = p.runs.iter().collect();
+        out.push(page::Figure {
+            file: "pipe_work_precision".into(),
+            svg: plots::pipe_work_precision("pipe_work_precision", &rows)?,
+            caption: "3D pipe (Hagen–Poiseuille, Re = 1, to ν t/R² = 1): wall time against the steady profile error, every finished run: colour the spacing (R/Δx = 8, 12, 16: Δx = 0.00125, 0.00083, 0.000625 m), marker the scheme (disc ISPH qiu, triangle WCSPH wcsph_xu).".into(),
         });
     }
     if !study.speedups.is_empty() {

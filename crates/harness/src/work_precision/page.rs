@@ -1,6 +1,7 @@
 //! The study's self-contained HTML page (maud; inline CSS, figures inlined as SVG).
 
 use super::channel::{ChannelRow, ChannelStudy};
+use super::pipe::{PipeRow, PipeStudy};
 use super::record::{Cost, RunRow, SchemeCost, Study};
 use crate::results::FLOOR_CORE_US_PER_PARTICLE_PASS;
 use maud::{DOCTYPE, Markup, PreEscaped, html};
@@ -139,6 +140,55 @@ fn channel_section(c: &ChannelStudy) -> Markup {
     }
 }
 
+fn pipe_row(r: &PipeRow) -> Markup {
+    let opt = |v: Option<f64>, digits: usize| v.map_or("—".into(), |x| format!("{x:.digits$}"));
+    let particles = match r.wall_particles {
+        Some(w) => format!("{} + {w}", r.cost.particles),
+        None => r.cost.particles.to_string(),
+    };
+    html! {
+        tr {
+            td class="l" { code { (r.id) } @if r.reused { " (cached)" } }
+            td class="l" { (r.scheme) }
+            td class="l" { (r.preset) }
+            td { (r.r_over_dx) }
+            td { (r.threads) }
+            td { (particles) }
+            td { (r.cost.steps) }
+            td { (format!("{:.2}", r.cost.wall_s)) }
+            td { (opt(r.cost.cpu_s, 2)) }
+            td { (r.particle_steps_per_s.map_or("—".into(), |v| format!("{v:.3e}"))) }
+            td { (opt(r.memory_peak_bytes.map(|b| b as f64 / 1e6), 1)) }
+            td { (opt(r.memory_rss_before_bytes.map(|b| b as f64 / 1e6), 1)) }
+            td { (opt(r.bytes_per_particle, 0)) }
+            td { (pct(r.error)) }
+            td { (pct(r.error_startup_max)) }
+            td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
+        }
+    }
+}
+
+fn pipe_section(p: &PipeStudy) -> Markup {
+    html! {
+        h2 { "3D pipe" }
+        p {
+            "Case " code { (p.case) } " (periodic Hagen–Poiseuille pipe, dummy-particle wall shell, Re = 1), from rest to ν t/R² = 1, "
+            "its presets as the validation runs them. Error: " (p.error_metric) ". Particles: fluid + wall (the wall's dummy particles counted "
+            "from the scene as the solver seeds them); particle-steps/s is fluid particles × steps over the wall time. Peak memory: "
+            (p.memory) " (the process's resident set before each run is shown beside it); bytes/particle divides it by the fluid and wall particles. MB = 10⁶ bytes."
+        }
+        ul { @for d in &p.design { li { (d) } } }
+        table class="small" {
+            tr {
+                th class="l" { "run" } th class="l" { "scheme" } th class="l" { "preset" } th { "R/Δx" } th { "threads" } th { "particles (fluid + wall)" }
+                th { "steps" } th { "wall [s]" } th { "CPU [s]" } th { "particle-steps/s" } th { "peak [MB]" } th { "resident before [MB]" } th { "bytes/particle" }
+                th { "profile error (ν t/R² = 1)" } th { "start-up max" } th class="l" { "status" }
+            }
+            @for r in &p.runs { (pipe_row(r)) }
+        }
+    }
+}
+
 /// The table of each scheme's cost per particle-step on each case ([`SchemeCost`]), and
 /// the floor it is measured against.
 fn scheme_cost_section(costs: &[SchemeCost], threads: usize) -> Markup {
@@ -185,28 +235,30 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
     let diverged = study.runs.iter().filter(|r| !r.ok()).count();
     let expected = study.runs.iter().filter(|r| !r.ok() && r.expected_divergence.is_some()).count();
     let reused = study.runs.iter().filter(|r| r.reused).count()
-        + study.channel.iter().flat_map(|c| &c.runs).filter(|r| r.reused).count();
+        + study.channel.iter().flat_map(|c| &c.runs).filter(|r| r.reused).count()
+        + study.pipe.iter().flat_map(|p| &p.runs).filter(|r| r.reused).count();
     html! {
         (DOCTYPE)
         html lang="en" {
             head {
                 meta charset="utf-8";
-                title { "Meniscus work-precision study (elliptical drop, periodic channel)" }
+                title { "Meniscus work-precision study (elliptical drop, periodic channel, 3D pipe)" }
                 style { (PreEscaped(CSS)) }
             }
             body {
-                h1 { "Work-precision study: elliptical drop and periodic channel" }
+                h1 { "Work-precision study: elliptical drop, periodic channel and 3D pipe" }
                 p {
                     "Wall time against the relative error of the semi-axis b at t = 0.008 s (second moments, against the ellipse ODE), for "
                     (study.runs.len()) " runs of the " code { (study.case) } " scene ("
                     (diverged) " diverged" @if expected > 0 { ", " (expected) " of them where the case file expects it" } "), tier " b { (study.tier) } ", " b { (m.build) } " build, " (study.threads) " threads for the main runs; the study took "
-                    (format!("{:.0}", study.elapsed_s)) " s (both studies)."
+                    (format!("{:.0}", study.elapsed_s)) " s (every part)."
                     @if !study.complete { " " b { "Incomplete: the study was interrupted." } }
                     @if reused > 0 {
                         " " b { (reused) " runs (marked cached) were taken from the run cache of an earlier invocation" }
                         " (" code { "--resume" } "): their times were measured then, under that invocation's load."
                     }
                     @if study.channel.is_some() { " The periodic channel's study has its own section and figure below." }
+                    @if study.pipe.is_some() { " So has the 3D pipe, with each run's particle-steps per second and peak memory." }
                     " Beside the ISPH option sets, both studies run the other schemes (WCSPH, MPS; see Design) as separate series, each with its own Pareto front."
                 }
                 h2 { "Targets" }
@@ -271,6 +323,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                     }
                 }
                 @if let Some(c) = &study.channel { (channel_section(c)) }
+                @if let Some(p) = &study.pipe { (pipe_section(p)) }
                 h2 { "Design" }
                 ul { @for d in &study.design { li { (d) } } }
                 p class="small" {

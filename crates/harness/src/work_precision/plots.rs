@@ -6,6 +6,7 @@
 //! (size, fonts, palette, legend on a translucent box, the scheme's marker).
 
 use super::channel::{ChannelRow, PRESET};
+use super::pipe::PipeRow;
 use super::record::{CostFit, RunRow, SpeedUp};
 use super::targets::thresholds;
 use crate::error::{HarnessError, Result};
@@ -97,6 +98,20 @@ struct Point<'a> {
     wall_s: f64,
     /// Text drawn at the point (the presets), if any.
     label: Option<String>,
+    /// Marker size \[px\]: the ISPH option sets small ([`OPTION_SET`]), the other schemes'
+    /// few points larger ([`PRESET_POINT`]).
+    size: i32,
+}
+
+/// Marker size of an ISPH option set among many \[px\].
+const OPTION_SET: i32 = 3;
+
+/// Marker size of a lone point (another scheme's, or one of few) \[px\].
+const PRESET_POINT: i32 = 5;
+
+/// The marker size of a run of `scheme` in the drop's and the channel's charts.
+fn size_of(scheme: &str) -> i32 {
+    if scheme == "isph" { OPTION_SET } else { PRESET_POINT }
 }
 
 /// A spacing rounded for a legend (D/36 = 0.005556).
@@ -162,8 +177,7 @@ fn front_chart(
             mine.sort_by_key(|p| p.scheme != "isph");
             chart
                 .draw_series(mine.iter().map(|p| -> DynElement<SVGBackend, (f64, f64)> {
-                    let size = if p.scheme == "isph" { 3 } else { 5 };
-                    scheme_marker!(p.scheme, (p.error, p.wall_s), size, c.mix(0.75))
+                    scheme_marker!(p.scheme, (p.error, p.wall_s), p.size, c.mix(0.75))
                 }))
                 .map_err(boxed)?
                 .label(format!("Δx = {} ({} runs)", dx_text(*dx), mine.len()))
@@ -237,6 +251,7 @@ pub fn work_precision(file: &str, runs: &[&RunRow], front: &[String]) -> Result<
                 error,
                 wall_s: r.cost.wall_s,
                 label: r.preset.as_ref().map(|name| format!("{name} Δx={}", r.dx)),
+                size: size_of(&r.scheme),
             })
         })
         .collect();
@@ -273,6 +288,7 @@ pub fn channel_work_precision(file: &str, runs: &[&ChannelRow], front: &[String]
                         if r.scheme == "isph" { name.clone() } else { format!("{} · {PRESET}", r.scheme) };
                     format!("{name} Δx={}", dx_text(r.dx))
                 }),
+                size: size_of(&r.scheme),
             })
         })
         .collect();
@@ -282,6 +298,36 @@ pub fn channel_work_precision(file: &str, runs: &[&ChannelRow], front: &[String]
         "relative L2 error of the velocity profile at τ = 1",
         &pts,
         front,
+        None,
+    )
+}
+
+/// The pipe's chart: wall time against the steady profile error at ν t/R² = 1 (finished
+/// runs), one marker per scheme, one colour per spacing, each point labelled with its
+/// preset and R/Δx; no Pareto front (one run per scheme and spacing).
+pub fn pipe_work_precision(file: &str, runs: &[&PipeRow]) -> Result<String> {
+    let pts: Vec<Point> = runs
+        .iter()
+        .filter(|r| r.ok())
+        .filter_map(|r| {
+            r.error.filter(|e| *e > 0.0).map(|error| Point {
+                id: &r.id,
+                scheme: &r.scheme,
+                series: format!("{} · {}", r.scheme, r.preset),
+                dx: r.dx,
+                error,
+                wall_s: r.cost.wall_s,
+                label: Some(format!("{} R/{}", r.preset, r.r_over_dx)),
+                size: PRESET_POINT,
+            })
+        })
+        .collect();
+    front_chart(
+        file,
+        "3D pipe (Re = 1): wall time against the steady profile error",
+        "relative L2 error of the radial velocity profile at ν t/R² = 1",
+        &pts,
+        &[],
         None,
     )
 }

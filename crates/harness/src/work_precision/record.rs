@@ -2,6 +2,7 @@
 
 use super::channel::ChannelStudy;
 use super::design::Variant;
+use super::pipe::PipeStudy;
 use crate::provenance::Provenance;
 use crate::results::FLOOR_CORE_US_PER_PARTICLE_PASS;
 use serde::{Deserialize, Serialize};
@@ -281,6 +282,9 @@ pub struct Study {
     /// The periodic channel's study (absent in files written before it existed).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub channel: Option<ChannelStudy>,
+    /// The 3D pipe's runs (absent in files written before it existed).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pipe: Option<PipeStudy>,
     /// Cost per particle-step of each scheme's presets on each case, against the floor
     /// (absent in files written before it existed).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -314,6 +318,7 @@ impl Study {
             speedups: vec![],
             targets: vec![],
             channel,
+            pipe: None,
             scheme_costs: vec![],
         }
     }
