@@ -1,5 +1,5 @@
 //! `cargo xtask bench [--quick|--full] [--out DIR] [--threads N] [--resume]`: the work-precision
-//! study of the elliptical drop and the periodic Poiseuille channel into
+//! study of the elliptical drop, the periodic Poiseuille channel and the 3D pipe into
 //! `reports/work_precision/`, in a release build (a dev-build invocation re-runs itself through
 //! `cargo run --release` unless `--dev-build`).
 
@@ -11,10 +11,10 @@ use std::process::ExitCode;
 /// Options of `cargo xtask bench`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// Drop Δx 0.04 and 0.02 only, few option sets; the channel at D/36 only (about 2 minutes).
+    /// Drop Δx 0.04 and 0.02 only, few option sets; the channel at D/36 only, the pipe at R/8 (about 2 minutes).
     #[arg(long, conflicts_with = "full")]
     quick: bool,
-    /// Adds drop Δx = 0.005 (the full range for the cost-per-step exponent) and channel Δx = 0.0025.
+    /// Adds drop Δx = 0.005 (the full range for the cost-per-step exponent), channel Δx = 0.0025 and the pipe at R/16.
     #[arg(long)]
     full: bool,
     /// Output directory [default: <workspace>/reports/work_precision].
@@ -65,7 +65,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let study = work_precision::run(&opts).context("the work-precision study could not run")?;
     let diverged = study.runs.iter().filter(|r| !r.ok()).count();
     eprintln!(
-        "drop: {} runs ({diverged} diverged); both studies in {:.0} s, tier {}, {} threads",
+        "drop: {} runs ({diverged} diverged); the study in {:.0} s, tier {}, {} threads",
         study.runs.len(),
         study.elapsed_s,
         study.tier,
@@ -78,6 +78,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             c.runs.len(),
             c.pareto.join(", ")
         );
+    }
+    if let Some(p) = &study.pipe {
+        let diverged = p.runs.iter().filter(|r| r.status != "ok").count();
+        eprintln!("pipe: {} runs ({diverged} diverged)", p.runs.len());
     }
     for t in &study.targets {
         let value = t.value.map_or("n/a".to_string(), |v| format!("{v:.3}"));
