@@ -143,6 +143,13 @@ fn frames_match_snapshots(name: &str, scene: &serde_json::Value) {
         let n = snap["p"].as_array().unwrap().len();
         assert!(n > 100, "{n} particles");
         assert_eq!(frame.points.len(), 3 * n, "three coordinates a point");
+        if scene["dimension"] == 3 {
+            // A ball: its particles' z spans about its diameter (a lost z would be all 0).
+            let z: Vec<f64> = frame.points.chunks(3).map(|p| p[2]).collect();
+            let span = z.iter().copied().fold(f64::NEG_INFINITY, f64::max)
+                - z.iter().copied().fold(f64::INFINITY, f64::min);
+            assert!(span > 1.5, "z spans {span}");
+        }
         assert_eq!(frame.types, vec![CellType::Vertex; n]);
         assert_close(&frame.points, &json_f64s(&snap["x"]), "positions");
         assert_close(&frame.f64s("velocity"), &json_f64s(&snap["u"]), "velocity");

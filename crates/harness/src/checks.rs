@@ -261,8 +261,9 @@ impl CheckSpec {
 
     /// Evaluates the check on the rows of `tier`; `None` when it does not apply: another
     /// tier, a selected preset, spacing or scheme that none of the rows has (it does not
-    /// run in this tier), or a single spacing for `decreasing`/`order`. A check that
-    /// applies but selects no row fails ("no run matches"): absent data never passes.
+    /// run in this tier), or a single spacing for `decreasing` / `order` / `finest_change`
+    /// (unless a selected run diverged: that fails). A check that applies but selects no
+    /// row fails ("no run matches"): absent data never passes.
     pub fn evaluate<R: Checked>(&self, rows: &[R], tier: Tier) -> Option<CheckResult> {
         if !self.applies(tier) {
             return None;
@@ -292,6 +293,19 @@ impl CheckSpec {
         let diverged: Vec<String> = picked.iter().filter_map(|r| r.failure()).collect();
         let selected: Vec<&RunResult> = picked.iter().map(|r| r.run()).collect();
         let (metric, missing) = (self.metric.as_str(), self.missing.as_deref());
+        // A run that diverged fails the check even where a multi-spacing kind has no verdict
+        // (one spacing left): absent data never passes, and a divergence never drops out.
+        let or_diverged = |r: Option<CheckResult>| match r {
+            None if !diverged.is_empty() => Some(CheckResult {
+                name: name.clone(),
+                value: None,
+                threshold: self.threshold(),
+                pass: false,
+                note: None,
+                expected_failure: None,
+            }),
+            r => r,
+        };
         let mut result = match self.kind()? {
             CheckKind::Max => bound(&name, &selected, metric, self.max?, |v, t| v <= t, f64::max, missing),
             CheckKind::Min => bound(&name, &selected, metric, self.min?, |v, t| v >= t, f64::min, missing),
@@ -302,9 +316,9 @@ impl CheckSpec {
                 let far = |a: f64, b: f64| if (a - want).abs() >= (b - want).abs() { a } else { b };
                 bound(&name, &selected, metric, want, |v, t| (v - t).abs() <= tol, far, missing)
             }
-            CheckKind::Decreasing => decreasing(&name, &selected, &self.metric)?,
-            CheckKind::Order => order(&name, &selected, &self.metric, self.min?)?,
-            CheckKind::FinestChange => finest_change(&name, &selected, &self.metric, self.max?)?,
+            CheckKind::Decreasing => or_diverged(decreasing(&name, &selected, &self.metric))?,
+            CheckKind::Order => or_diverged(order(&name, &selected, &self.metric, self.min?))?,
+            CheckKind::FinestChange => or_diverged(finest_change(&name, &selected, &self.metric, self.max?))?,
         };
         if !diverged.is_empty() {
             result.pass = false;
@@ -637,6 +651,11 @@ mod tests {
     /// does not.
     #[test]
     fn finest_change_judges_the_two_finest_spacings() {
+        // One spacing: no verdict, unless its run diverged, which fails the check.
+        let c1 = spec(json!({"kind": "finest_change", "metric": "b_rel_err_max", "max": 0.05}));
+        let diverged = vec![run("paper", 0.04, 0.5, 1976, "diverged")];
+        let r = c1.evaluate(&diverged, Tier::Quick).expect("a divergence is judged");
+        assert!(!r.pass && r.note.as_deref().is_some_and(|n| n.contains("diverged")), "{r:?}");
         let mut rows = vec![
             run("paper", 0.04, 0.5, 1976, "ok"),
             run("paper", 0.02, 0.0100, 7860, "ok"),

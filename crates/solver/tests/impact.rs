@@ -5,7 +5,7 @@
 use meniscus::Scene;
 use serde_json::{Value, json};
 
-/// A holdout impact (not the case's): D = 1 mm at V = 1.2 m/s (We 16.5, Re 1200), D/Δx = 10,
+/// A holdout impact (not the case's): D = 1 mm at V = 1.2 m/s (We 19.8, Re 1200), D/Δx = 10,
 /// on a plate 2.4 D wide, to T = tV/D = `t_end`.
 fn impact(t_end: f64) -> Value {
     let (d, v) = (1e-3, 1.2);
@@ -47,16 +47,18 @@ fn the_wetted_diameter_follows_the_early_law_the_same_on_any_thread_count() {
     let diameter = p.get("spread", "diameter").expect("diameter");
     // Between T = 0.15 and 0.3 the wetted diameter is within 20 % of √(6T) D at D/10 (the first
     // row's layer widens it by O(√(Δx D)) earlier on), and grows.
-    let mut last = 0.0;
+    let (mut last, mut checked) = (0.0, 0);
     for (t, dm) in p.t.iter().zip(diameter) {
         let ts = t * v / d;
         if ts >= 0.15 {
+            checked += 1;
             let law = (6.0 * ts).sqrt() * d;
             assert!((dm / law - 1.0).abs() < 0.2, "T = {ts}: d/D = {} against {}", dm / d, law / d);
             assert!(*dm >= last - 0.5e-4, "the wetted diameter shrank at T = {ts}");
             last = *dm;
         }
     }
+    assert!(checked > 5, "{checked} samples in 0.15 <= T <= 0.3");
     let height = p.get("spread", "height").expect("height");
     assert!(height[0] > 0.99 * d && *height.last().unwrap() < 0.9 * d, "{height:?}");
     let two = run(&scene, 2);
@@ -71,7 +73,6 @@ fn bad_spread_probes_are_named() {
     for (probe, field) in [
         (json!({ "spread": { "axis": 3, "position": 0.0 } }), "probes[0].spread.axis"),
         (json!({ "spread": { "axis": 2, "position": 0.0, "layer": -1e-4 } }), "probes[0].spread.layer"),
-        (json!({ "spread": { "axis": 2, "position": f64::MAX * 2.0 } }), "probes[0].spread.position"),
     ] {
         let mut scene = impact(0.1);
         scene["probes"] = json!([probe]);

@@ -8,8 +8,9 @@ use meniscus::ProbeRecord;
 use meniscus_reference::ReferenceError;
 use meniscus_reference::impact::{Impact, beta_max_band, early_spread};
 
-/// The early-spreading window `[T_0, T_1]` of `T = tV/D` (CASES.md: `0.05 ≤ T ≤ 0.2`):
-/// after the first rows of particles have touched, before the lamella's growth slows.
+/// The early-spreading window `[T_0, T_1]` of `T = tV/D` (issue #36: `0.05 ≤ T ≤ 0.2`;
+/// CASES.md gives `T < 0.2`): after the first rows of particles have touched, before the
+/// lamella's growth slows.
 pub const EARLY: [f64; 2] = [0.05, 0.2];
 
 /// The early reference `√(6T)` is drawn up to this `T` (beyond it the law does not hold).
@@ -48,8 +49,9 @@ impl Params {
 /// Series `t_star` (T), `beta` (wetted diameter / D), `width_over_d` (spread width / D),
 /// `height_over_d` and `beta_early` (√(6T) up to T = 0.5, NaN after); metrics
 /// `spread_early_rel_err_max` (largest |β/√(6T) − 1| over [`EARLY`]), `beta_max` and the
-/// `t_star_beta_max` it is reached at, `width_max_over_d`, the correlations' band
-/// `beta_max_ref_lo` / `beta_max_ref_hi`, `we` and `re`.
+/// `t_star_beta_max` it is reached at, `width_max_over_d`, `clusters_max` (the most separate
+/// bodies of the `drop_shape` probe over the run: a lamella that tore, or two drops before
+/// they merge), the correlations' band `beta_max_ref_lo` / `beta_max_ref_hi`, `we` and `re`.
 pub fn compute(p: &Params, probes: &ProbeRecord) -> Result<Measured, ReferenceError> {
     let impact = Impact::new(p.diameter, p.speed, p.density, p.viscosity, p.sigma)?;
     let t = &probes.t;
@@ -84,6 +86,8 @@ pub fn compute(p: &Params, probes: &ProbeRecord) -> Result<Measured, ReferenceEr
     m.metrics.insert("beta_max".into(), beta_max);
     m.metrics.insert("t_star_beta_max".into(), at);
     m.metrics.insert("width_max_over_d".into(), nan_max(&width));
+    let clusters = probes.get("drop_shape", "clusters").map_or(f64::NAN, nan_max);
+    m.metrics.insert("clusters_max".into(), clusters);
     m.metrics.insert("beta_max_ref_lo".into(), lo);
     m.metrics.insert("beta_max_ref_hi".into(), hi);
     m.metrics.insert("we".into(), impact.we);
@@ -120,11 +124,15 @@ mod tests {
         s.insert("diameter".into(), ts.iter().map(|&x| beta(x) * p.diameter).collect());
         s.insert("width".into(), ts.iter().map(|&x| beta(x).max(1.0) * p.diameter).collect());
         s.insert("height".into(), vec![p.diameter; ts.len()]);
+        let mut pieces = vec![1.0; ts.len()];
+        pieces[200] = 3.0;
+        probes.series.entry("drop_shape".into()).or_default().insert("clusters".into(), pieces);
         let m = compute(&p, &probes).unwrap();
         assert!((m.metrics["spread_early_rel_err_max"] - 0.05).abs() < 1e-9);
         assert!(
             (m.metrics["beta_max"] - 2.6).abs() < 1e-9 && (m.metrics["t_star_beta_max"] - 2.0).abs() < 1e-9
         );
+        assert!((m.metrics["clusters_max"] - 3.0).abs() < 1e-12);
         assert!(m.metrics["beta_max_ref_lo"] < 2.4 && m.metrics["beta_max_ref_hi"] > 2.98);
         assert!(
             m.series["beta_early"][60].is_nan() && (m.series["beta_early"][10] - 0.6f64.sqrt()).abs() < 1e-12
@@ -132,13 +140,16 @@ mod tests {
         // A NaN sample (a diverged step) makes the maximum NaN, never a smaller number.
         probes.series.get_mut("spread").unwrap().get_mut("diameter").unwrap()[250] = f64::NAN;
         assert!(compute(&p, &probes).unwrap().metrics["beta_max"].is_nan());
+        probes.series.get_mut("drop_shape").unwrap().get_mut("clusters").unwrap()[5] = f64::NAN;
+        assert!(compute(&p, &probes).unwrap().metrics["clusters_max"].is_nan());
     }
 
     #[test]
     fn missing_probe_and_bad_fluid() {
         let p = params();
         let probes = ProbeRecord { t: vec![0.0, 1e-5], ..Default::default() };
-        assert!(compute(&p, &probes).unwrap().metrics["beta_max"].is_nan());
+        let m = compute(&p, &probes).unwrap();
+        assert!(m.metrics["beta_max"].is_nan() && m.metrics["clusters_max"].is_nan());
         let no_sigma = Params::new(5e-4, 2.7, &json!({ "fluid": { "density": 1000.0, "viscosity": 1e-3 } }));
         assert!(compute(&no_sigma, &probes).is_err());
     }

@@ -358,7 +358,7 @@ pub fn figures(study: &Study) -> Result<Vec<page::Figure>> {
         out.push(page::Figure {
             file: "pipe_work_precision".into(),
             svg: plots::pipe_work_precision("pipe_work_precision", &rows)?,
-            caption: "3D pipe (Hagen–Poiseuille, Re = 1, to ν t/R² = 1): wall time against the steady profile error, every finished run: colour the spacing (R/Δx = 8, 12, 16: Δx = 0.00125, 0.00083, 0.000625 m), marker the scheme (disc ISPH qiu, triangle WCSPH wcsph_xu).".into(),
+            caption: "3D pipe (Hagen–Poiseuille, Re = 1, to ν t/R² = 1): wall time against the steady profile error, every finished run: colour the spacing (the tier's R/Δx of 8, 12, 16: Δx = 0.00125, 0.00083, 0.000625 m), marker the scheme (disc ISPH qiu, triangle WCSPH wcsph_xu).".into(),
         });
     }
     if !study.speedups.is_empty() {
