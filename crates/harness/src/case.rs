@@ -17,7 +17,7 @@
 //! A preset is a JSON merge patch (RFC 7396, [`crate::patch`]) applied to the template;
 //! the first preset is the case's primary one (its orders go into `convergence`).
 
-use crate::checks::{CheckSpec, same_spacing};
+use crate::checks::{CheckKind, CheckSpec, same_spacing};
 use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::provenance::Provenance;
@@ -582,7 +582,21 @@ impl Case {
                 schemes.join(", ")
             ));
         }
+        // A check across spacings never applies to one spacing: a `select.dx`, or a listed
+        // tier with a single spacing, would silently keep it from judging anything.
+        let across =
+            matches!(c.kind(), Some(CheckKind::Decreasing | CheckKind::Order | CheckKind::FinestChange));
+        if across && let Some(d) = sel.dx {
+            return Err(format!(
+                "`select.dx` = {d} on a check across spacings, which one spacing cannot judge"
+            ));
+        }
         for &tier in c.tiers.iter().flatten() {
+            if across && self.spacings(tier).len() < 2 {
+                return Err(format!(
+                    "lists tier `{tier}`, which has one spacing: a check across spacings never applies there"
+                ));
+            }
             if let Some(p) = &sel.preset
                 && !self.presets(tier).any(|q| q.name == *p)
             {
@@ -724,10 +738,24 @@ mod tests {
             (serde_json::json!({"select": {"dx": 0.03}}), "`select.dx` = 0.03"),
             (serde_json::json!({"select": {"scheme": "otm"}}), "`select.scheme` = \"otm\""),
             (serde_json::json!({"select": {"dx": 0.005}, "tiers": ["quick"]}), "tier `quick`"),
+            (
+                serde_json::json!({"kind": "decreasing", "max": null, "select": {"dx": 0.02}}),
+                "check across spacings",
+            ),
         ] {
             let e = error(&|c| crate::patch::merge_patch(c, &edit)).unwrap_or_default();
             assert!(e.contains("the check") && e.contains(says), "{edit}: {e}");
         }
+        // A tier with one spacing cannot judge a check across spacings.
+        let mut v = serde_json::to_value(repo_case()).unwrap();
+        v["sweep"]["dx"]["quick"] = serde_json::json!([0.04]);
+        v["checks"][0] = serde_json::json!({"name": "the check", "kind": "finest_change", "metric": "b_rel_err_max",
+                                            "max": 0.05, "tiers": ["quick", "full"]});
+        let e = Case::from_json(&v.to_string(), Path::new("x.json"))
+            .err()
+            .map(|e| e.to_string())
+            .unwrap_or_default();
+        assert!(e.contains("tier `quick`") && e.contains("one spacing"), "{e}");
     }
 
     /// Published values name a preset, a metric and spacings of the case: the channel's
