@@ -13,13 +13,15 @@
 //! `a_extent_rel_err_max`, `b_extent_rel_err_max`, `a_extent_rel_err_final`,
 //! `b_extent_rel_err_final`, `pc_rel_err_final`, `pc_rel_err_max`, `pc_rel_err_late` (the
 //! centre pressure over its reference averaged over the last quarter of the run: the
-//! pressure oscillates, acoustically under WCSPH, so its final sample is a draw), `ke_drift`,
+//! pressure oscillates, acoustically under WCSPH, so its final sample is a draw),
+//! `pc_rel_err_max_late` (the largest centre-pressure error over the second half of the
+//! run: a pressure right over the whole late history, not on average), `ke_drift`,
 //! `ke_rel_err_initial` (against `rho pi R^4 A0^2 / 4`), `momentum_drift` (largest |linear
 //! momentum| over the scale `rho pi R^2 A0 R`), `t_final`.
 //! Series: `t`, `a_moment`, `b_moment`, `a_extent`, `b_extent`, `p`, `e`, and the
 //! reference `a_ref`, `b_ref`, `pc_ref` on the same `t`.
 
-use super::{Measured, drift, nan_max, rel_err_final, rel_err_late, rel_err_max};
+use super::{Measured, drift, nan_max, rel_err_final, rel_err_late, rel_err_max, rel_err_max_late};
 use meniscus::ProbeRecord;
 use meniscus_reference::ReferenceError;
 use meniscus_reference::elliptical_drop::EllipticalDrop;
@@ -37,6 +39,10 @@ pub struct Params {
 
 /// Fraction of the run, at its end, over which `pc_rel_err_late` averages.
 pub const LATE_FRACTION: f64 = 0.25;
+
+/// Fraction of the run, at its end, over which `pc_rel_err_max_late` takes the largest
+/// error: the second half (issue #37: the pressure held over the whole late history).
+pub const SECOND_HALF: f64 = 0.5;
 
 /// The probe kinds and quantities read (DESIGN.md "Run outputs").
 const AXES: &str = "ellipse_axes";
@@ -76,6 +82,7 @@ pub fn compute(params: &Params, probes: &ProbeRecord) -> Result<Measured, Refere
         m.insert("pc_rel_err_final".into(), rel_err_final(p, &pc_ref));
         m.insert("pc_rel_err_late".into(), rel_err_late(t, p, &pc_ref, LATE_FRACTION));
         m.insert("pc_rel_err_max".into(), rel_err_max(p, &pc_ref));
+        m.insert("pc_rel_err_max_late".into(), rel_err_max_late(t, p, &pc_ref, SECOND_HALF));
         out.series.insert("p".into(), p.to_vec());
     }
     if let Some(e) = probes.get("kinetic_energy", "e") {

@@ -115,6 +115,21 @@ pub fn rel_err_late(t: &[f64], values: &[f64], reference: &[f64], fraction: f64)
     (ratios.iter().sum::<f64>() / ratios.len() as f64 - 1.0).abs()
 }
 
+/// Largest relative error over the late history: `max |v/r − 1|` over the samples in the
+/// last `fraction` of the time span (an oscillating quantity held over a window, not read
+/// at one instant). NaN when a sample in the window is, or there is none.
+pub fn rel_err_max_late(t: &[f64], values: &[f64], reference: &[f64], fraction: f64) -> f64 {
+    let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else { return f64::NAN };
+    let from = t1 - fraction * (t1 - t0);
+    let errors: Vec<f64> = t
+        .iter()
+        .zip(values.iter().zip(reference))
+        .filter(|(ti, _)| **ti >= from)
+        .map(|(_, (v, r))| ((v - r) / r).abs())
+        .collect();
+    nan_max(&errors)
+}
+
 /// Largest relative drift from the first sample, `max_t |x(t) - x(0)| / |x(0)|`.
 pub fn drift(values: &[f64]) -> f64 {
     match values.first() {
@@ -176,6 +191,19 @@ mod tests {
         assert!((rel_err_final(&[1.0, 4.4], &[1.0, 4.0]) - 0.1).abs() < 1e-12);
         assert!(rel_err_max(&[], &[]).is_nan());
         assert!(rel_err_final(&[], &[]).is_nan());
+    }
+
+    #[test]
+    fn late_maximum_reads_only_the_window() {
+        let t = [0.0, 1.0, 2.0, 3.0, 4.0];
+        let reference = [2.0; 5];
+        // A 50 % excursion in the first half does not count; the worst late one (10 %) does,
+        // and the sample at the window's start (t = 2) belongs to it.
+        let values = [3.0, 2.1, 1.8, 2.1, 2.0];
+        assert!((rel_err_max_late(&t, &values, &reference, 0.5) - 0.1).abs() < 1e-12);
+        assert!((rel_err_max_late(&t, &values, &reference, 1.0) - 0.5).abs() < 1e-12);
+        assert!(rel_err_max_late(&t, &[3.0, 2.1, 1.8, f64::NAN, 2.0], &reference, 0.5).is_nan());
+        assert!(rel_err_max_late(&[], &[], &[], 0.5).is_nan());
     }
 
     #[test]
