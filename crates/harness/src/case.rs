@@ -119,6 +119,10 @@ pub struct Preset {
     /// Tiers in which this preset runs (all when absent).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tiers: Option<Vec<Tier>>,
+    /// This preset's spacings per tier \[m\], in place of `sweep.dx` for the tiers it
+    /// lists (a preset that converges where the others diverge runs finer).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dx: Option<BTreeMap<Tier, Vec<f64>>>,
     /// Spacings at which this preset is known to diverge, with the measured reason: such a
     /// run's divergence is an expected failure, its completion an unexpected pass. Any
     /// other run must reach its end time.
@@ -412,6 +416,32 @@ impl Case {
         self.sweep.dx.get(&tier).map(Vec::as_slice).unwrap_or(&[])
     }
 
+    /// Spacings of `preset` in `tier`: its own `dx` for the tier, else the sweep's.
+    pub fn preset_spacings<'a>(&'a self, preset: &'a Preset, tier: Tier) -> &'a [f64] {
+        match preset.dx.as_ref().and_then(|d| d.get(&tier)) {
+            Some(dx) => dx,
+            None => self.spacings(tier),
+        }
+    }
+
+    /// Every spacing of any tier, of the sweep and of the presets' own lists.
+    fn all_spacings(&self) -> impl Iterator<Item = f64> + '_ {
+        let own = self.sweep.presets.iter().filter_map(|p| p.dx.as_ref());
+        self.sweep.dx.values().chain(own.flat_map(|d| d.values())).flatten().copied()
+    }
+
+    /// Spacings run in `tier` by the preset `select` names (by any preset when it names none).
+    fn selected_spacings(&self, preset: Option<&str>, tier: Tier) -> Vec<f64> {
+        let mut dx: Vec<f64> = self
+            .presets(tier)
+            .filter(|p| preset.is_none_or(|n| n == p.name))
+            .flat_map(|p| self.preset_spacings(p, tier).iter().copied())
+            .collect();
+        dx.sort_by(|a, b| b.total_cmp(a));
+        dx.dedup_by(|a, b| same_spacing(*a, *b));
+        dx
+    }
+
     /// Presets that run in `tier`.
     pub fn presets(&self, tier: Tier) -> impl Iterator<Item = &Preset> {
         self.sweep.presets.iter().filter(move |p| p.tiers.as_ref().is_none_or(|t| t.contains(&tier)))
@@ -452,9 +482,7 @@ impl Case {
                         p.name
                     )));
                 }
-                if let Some(d) =
-                    e.dx.iter().find(|&&d| !self.sweep.dx.values().flatten().any(|&s| same_spacing(s, d)))
-                {
+                if let Some(d) = e.dx.iter().find(|&&d| !self.all_spacings().any(|s| same_spacing(s, d))) {
                     return Err(err(format!(
                         "preset `{}`: `expected_divergence.dx` has {d}, not a spacing of `sweep.dx`",
                         p.name
@@ -473,6 +501,22 @@ impl Case {
                 return Err(err(format!("sweep.dx.{tier} has {bad}: spacings must be positive")));
             }
         }
+        for p in &self.sweep.presets {
+            for (tier, dx) in p.dx.iter().flatten() {
+                if let Some(bad) = dx.iter().find(|d| !(d.is_finite() && **d > 0.0)) {
+                    return Err(err(format!(
+                        "preset `{}`: `dx.{tier}` has {bad}: spacings must be positive",
+                        p.name
+                    )));
+                }
+                if dx.is_empty() {
+                    return Err(err(format!(
+                        "preset `{}`: `dx.{tier}` is empty: give its spacings or leave the tier out",
+                        p.name
+                    )));
+                }
+            }
+        }
         for (i, p) in self.published.iter().enumerate() {
             let field = format!("published[{i}]");
             if !names.contains(&p.preset) {
@@ -485,7 +529,7 @@ impl Case {
                 )));
             }
             if let Some([d, _]) =
-                p.values.iter().find(|[d, _]| !self.sweep.dx.values().flatten().any(|&s| same_spacing(s, *d)))
+                p.values.iter().find(|[d, _]| !self.all_spacings().any(|s| same_spacing(s, *d)))
             {
                 return Err(err(format!("`{field}.values` has dx = {d}, not a spacing of `sweep.dx`")));
             }
@@ -523,12 +567,10 @@ impl Case {
     /// with the field.
     fn check_starts(&self, p: &Preset, s: &PerturbedStarts) -> std::result::Result<(), String> {
         // The spacings of the tiers the preset runs in.
-        let all: Vec<f64> = self
-            .sweep
-            .dx
-            .iter()
-            .filter(|(tier, _)| p.tiers.as_ref().is_none_or(|t| t.contains(tier)))
-            .flat_map(|(_, dx)| dx.iter().copied())
+        let all: Vec<f64> = Tier::ALL
+            .into_iter()
+            .filter(|tier| p.tiers.as_ref().is_none_or(|t| t.contains(tier)))
+            .flat_map(|tier| self.preset_spacings(p, tier).iter().copied())
             .collect();
         if s.reason.trim().is_empty() {
             return Err("reason` is empty: say what a bit-level change of the start redraws".into());
@@ -569,7 +611,7 @@ impl Case {
             ));
         }
         if let Some(d) = sel.dx
-            && !self.sweep.dx.values().flatten().any(|&s| same_spacing(s, d))
+            && !self.all_spacings().any(|s| same_spacing(s, d))
         {
             return Err(format!("`select.dx` = {d} is not a spacing of `sweep.dx`"));
         }
@@ -592,7 +634,8 @@ impl Case {
             ));
         }
         for &tier in c.tiers.iter().flatten() {
-            if across && self.spacings(tier).len() < 2 {
+            let spacings = self.selected_spacings(sel.preset.as_deref(), tier);
+            if across && spacings.len() < 2 {
                 return Err(format!(
                     "lists tier `{tier}`, which has one spacing: a check across spacings never applies there"
                 ));
@@ -603,7 +646,7 @@ impl Case {
                 return Err(format!("lists tier `{tier}`, in which preset {p:?} does not run"));
             }
             if let Some(d) = sel.dx
-                && !self.spacings(tier).iter().any(|&s| same_spacing(s, d))
+                && !spacings.iter().any(|&s| same_spacing(s, d))
             {
                 return Err(format!("lists tier `{tier}`, whose spacings do not include {d}"));
             }
@@ -700,7 +743,7 @@ mod tests {
         assert_eq!(case.spacings(Tier::Quick), [0.04, 0.02]);
         assert_eq!(case.spacings(Tier::Full).len(), 4);
         assert_eq!(case.primary_preset(), "paper");
-        assert_eq!(case.presets(Tier::Quick).count(), 6);
+        assert_eq!(case.presets(Tier::Quick).count(), 7);
         assert!(case.checks.len() >= 8);
         assert!(!case.errata.is_empty());
     }
@@ -746,11 +789,12 @@ mod tests {
             let e = error(&|c| crate::patch::merge_patch(c, &edit)).unwrap_or_default();
             assert!(e.contains("the check") && e.contains(says), "{edit}: {e}");
         }
-        // A tier with one spacing cannot judge a check across spacings.
+        // A tier with one spacing cannot judge a check across spacings (for the selected
+        // preset: tuned_h18 has spacings of its own).
         let mut v = serde_json::to_value(repo_case()).unwrap();
         v["sweep"]["dx"]["quick"] = serde_json::json!([0.04]);
         v["checks"][0] = serde_json::json!({"name": "the check", "kind": "finest_change", "metric": "b_rel_err_max",
-                                            "max": 0.05, "tiers": ["quick", "full"]});
+                                            "select": {"preset": "paper"}, "max": 0.05, "tiers": ["quick", "full"]});
         let e = Case::from_json(&v.to_string(), Path::new("x.json"))
             .err()
             .map(|e| e.to_string())

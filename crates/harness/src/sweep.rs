@@ -2,6 +2,7 @@
 
 use crate::cache::sha256_hex;
 use crate::case::Case;
+use crate::checks::same_spacing;
 use crate::error::{HarnessError, Result};
 use crate::patch::merge_patch;
 use crate::results::{slug, start_slug};
@@ -152,16 +153,19 @@ pub fn perturbed_spec(case: &Case, preset: &str, dx: f64, seed: u64) -> Result<R
 /// Every run of `case` in `tier`: spacings from coarse to fine, presets in file order, each
 /// preset's perturbed starts after its run.
 pub fn expand(case: &Case, tier: Tier) -> Result<Vec<RunSpec>> {
-    let mut dx = case.spacings(tier).to_vec();
-    if dx.is_empty() {
+    if case.spacings(tier).is_empty() {
         return Err(HarnessError::case(&case.case, format!("no spacings for tier `{tier}` in sweep.dx")));
     }
-    dx.sort_by(|a, b| b.total_cmp(a));
-    dx.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
     let presets: Vec<&crate::case::Preset> = case.presets(tier).collect();
+    // The union of the presets' spacings (a preset may have its own, `presets[].dx`).
+    let mut dx: Vec<f64> =
+        presets.iter().flat_map(|p| case.preset_spacings(p, tier).iter().copied()).collect();
+    dx.sort_by(|a, b| b.total_cmp(a));
+    dx.dedup_by(|a, b| same_spacing(*a, *b));
     let mut out = Vec::with_capacity(dx.len() * presets.len());
     for &d in &dx {
-        for p in &presets {
+        for p in presets.iter().filter(|p| case.preset_spacings(p, tier).iter().any(|&s| same_spacing(s, d)))
+        {
             out.push(spec(case, &p.name, d)?);
             for &seed in p.starts_at(d) {
                 out.push(perturbed_spec(case, &p.name, d, seed)?);
@@ -186,40 +190,76 @@ mod tests {
             [
                 "isph-paper_dx0.04",
                 "isph-tuned_dx0.04",
+                "isph-tuned_h18_dx0.04",
                 "wcsph-wcsph_paper_dx0.04",
                 "wcsph-wcsph_tuned_dx0.04",
                 "mps-mps_paper_dx0.04",
                 "mps-mps_dx0.04",
                 "isph-paper_dx0.02",
                 "isph-tuned_dx0.02",
+                "isph-tuned_h18_dx0.02",
                 "wcsph-wcsph_paper_dx0.02",
                 "wcsph-wcsph_tuned_dx0.02",
                 "mps-mps_paper_dx0.02",
                 "mps-mps_dx0.02"
             ]
         );
-        assert!((runs[6].scene.dx - 0.02).abs() < 1e-15);
+        assert!((runs[7].scene.dx - 0.02).abs() < 1e-15);
         // The tuned preset's merge patch replaces Xu shifting by Fickian shifting.
         assert_eq!(runs[1].scene_json["scheme"]["isph"]["divergence"], "corrected");
         assert!(runs[1].scene_json["scheme"]["isph"]["shifting"].get("xu").is_none());
         assert_eq!(runs[1].scene_json["scheme"]["isph"]["shifting"]["fickian"]["coefficient"], 2.0);
         assert!(runs[0].scene_json["scheme"]["isph"]["shifting"].get("xu").is_some());
+        // tuned_h18 widens the kernel.
+        assert_eq!(runs[2].scene_json["kernel"]["h_over_dx"], 1.8);
         // The WCSPH presets replace the scheme (and the fixed step by the adaptive one).
-        assert!(runs[2].scene_json["scheme"].get("isph").is_none());
-        assert_eq!(runs[2].scene_json["scheme"]["wcsph"]["sound_speed"], 1000.0);
-        assert!(runs[2].scene_json["time"]["step"].get("adaptive").is_some());
+        assert!(runs[3].scene_json["scheme"].get("isph").is_none());
+        assert_eq!(runs[3].scene_json["scheme"]["wcsph"]["sound_speed"], 1000.0);
+        assert!(runs[3].scene_json["time"]["step"].get("adaptive").is_some());
         assert_eq!(runs[0].hash.len(), 64);
         assert_ne!(runs[0].hash, runs[1].hash);
-        assert_ne!(runs[0].hash, runs[6].hash);
+        assert_ne!(runs[0].hash, runs[7].hash);
         // The MPS presets replace the scheme too.
-        assert_eq!(runs[5].scene_json["scheme"]["mps"]["gamma"], 0.01);
+        assert_eq!(runs[6].scene_json["scheme"]["mps"]["gamma"], 0.01);
+        // Seven presets at 0.04 … 0.005, the 20 ms run at 0.01, tuned_h18 alone at 0.0025.
         let full = expand(&committed("elliptical_drop"), Tier::Full).unwrap();
-        assert_eq!(full.len(), 24);
+        assert_eq!(full.len(), 30);
+        assert_eq!(full[17].slug, "isph-tuned_h18_20ms_dx0.01");
+        assert_eq!(full[29].slug, "isph-tuned_h18_dx0.0025");
         // Δt scales with dx below the template's 0.02 (CFL number kept), not above it.
         let dt = |r: &RunSpec| r.scene_json["time"]["step"]["fixed"].as_f64().unwrap();
         assert!((dt(&full[0]) - 2e-5).abs() < 1e-18, "dx = 0.04 keeps the paper's dt");
-        assert!((dt(&full[6]) - 2e-5).abs() < 1e-18);
-        assert!((dt(&full[18]) - 5e-6).abs() < 1e-18, "dx = 0.005: {}", dt(&full[18]));
+        assert!((dt(&full[7]) - 2e-5).abs() < 1e-18);
+        assert!((dt(&full[22]) - 5e-6).abs() < 1e-18, "dx = 0.005: {}", dt(&full[22]));
+        assert!((dt(&full[29]) - 2.5e-6).abs() < 1e-18, "dx = 0.0025: {}", dt(&full[29]));
+    }
+
+    /// A preset with its own spacings runs them, and only it runs the spacings the sweep
+    /// lacks; a check across spacings on it may list a tier where the sweep has one.
+    #[test]
+    fn a_preset_may_run_its_own_spacings() {
+        let mut v = serde_json::to_value(committed("elliptical_drop")).unwrap();
+        v["sweep"]["dx"]["quick"] = serde_json::json!([0.04]);
+        v["sweep"]["presets"][1]["dx"] = serde_json::json!({"quick": [0.04, 0.02, 0.01]});
+        v["checks"][0] = serde_json::json!({"name": "tuned converges", "kind": "decreasing", "metric": "b_rel_err_max",
+                                            "select": {"preset": "tuned"}, "tiers": ["quick"]});
+        let c = Case::from_json(&v.to_string(), std::path::Path::new("x.json")).unwrap();
+        let runs = expand(&c, Tier::Quick).unwrap();
+        let slugs: Vec<&str> = runs.iter().map(|r| r.slug.as_str()).collect();
+        assert_eq!(slugs.len(), 10, "{slugs:?}");
+        assert_eq!(slugs[7..], ["isph-tuned_dx0.02", "isph-tuned_h18_dx0.02", "isph-tuned_dx0.01"]);
+        assert!((runs[9].scene.dx - 0.01).abs() < 1e-15);
+        // Other tiers keep the sweep's spacings for it (0.04, 0.02: 7 presets each), and
+        // tuned_h18 its own (with its 20 ms run at 0.01).
+        assert_eq!(expand(&c, Tier::Default).unwrap().len(), 17);
+        // The same check on the paper preset, which has one quick spacing, is refused.
+        v["checks"][0]["select"]["preset"] = "paper".into();
+        let e = Case::from_json(&v.to_string(), std::path::Path::new("x.json")).unwrap_err();
+        assert!(e.to_string().contains("one spacing"), "{e}");
+        v["checks"][0]["select"]["preset"] = "tuned".into();
+        v["sweep"]["presets"][1]["dx"] = serde_json::json!({"quick": []});
+        let e = Case::from_json(&v.to_string(), std::path::Path::new("x.json")).unwrap_err();
+        assert!(e.to_string().contains("`dx.quick` is empty"), "{e}");
     }
 
     #[test]
@@ -232,15 +272,15 @@ mod tests {
         let runs = expand(&c, Tier::Quick).unwrap();
         let slugs: Vec<&str> = runs.iter().map(|r| r.slug.as_str()).collect();
         assert_eq!(
-            slugs[6..9],
+            slugs[7..10],
             ["isph-paper_dx0.02", "isph-paper_dx0.02_start1", "isph-paper_dx0.02_start2"]
         );
-        assert_eq!(runs.len(), 14, "two more runs at 0.02, none at 0.04");
-        assert_eq!((runs[7].start, runs[8].start), (Some(1), Some(2)));
-        let jitter = &runs[8].scene_json["bodies"][0]["jitter"];
+        assert_eq!(runs.len(), 16, "two more runs at 0.02, none at 0.04");
+        assert_eq!((runs[8].start, runs[9].start), (Some(1), Some(2)));
+        let jitter = &runs[9].scene_json["bodies"][0]["jitter"];
         assert_eq!((jitter["fraction"].as_f64(), jitter["seed"].as_u64()), (Some(1e-12), Some(2)));
-        assert!(runs[6].scene_json["bodies"][0].get("jitter").is_none_or(|j| j.is_null()));
-        assert!(runs[6].hash != runs[7].hash && runs[7].hash != runs[8].hash);
+        assert!(runs[7].scene_json["bodies"][0].get("jitter").is_none_or(|j| j.is_null()));
+        assert!(runs[7].hash != runs[8].hash && runs[8].hash != runs[9].hash);
         // Malformed ensembles are rejected when the case loads, naming the field.
         for (bad, field) in [
             (serde_json::json!({"dx": [0.03], "seeds": [1], "reason": "r"}), "perturbed_starts.dx"),

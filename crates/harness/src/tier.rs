@@ -16,6 +16,9 @@ pub enum Tier {
 }
 
 impl Tier {
+    /// Every tier, from the quickest.
+    pub const ALL: [Tier; 3] = [Tier::Quick, Tier::Default, Tier::Full];
+
     /// The tier's name as written in files.
     pub fn name(self) -> &'static str {
         match self {
