@@ -35,7 +35,7 @@ pub struct Params {
 impl Params {
     /// The impact of a drop of `diameter` at `speed` in the liquid of `scene`'s `fluid`.
     pub fn new(diameter: f64, speed: f64, scene: &serde_json::Value) -> Self {
-        let num = |k: &str| scene["fluid"][k].as_f64().unwrap_or(f64::NAN);
+        let num = |k: &str| super::fluid_property(scene, k);
         Self {
             diameter,
             speed,

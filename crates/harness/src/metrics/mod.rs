@@ -61,8 +61,7 @@ pub fn compute(
         }
         ReferenceSpec::OscillatingDrop { radius, sigma, density } => {
             let dim = capillarity::dimension(scene)?;
-            let num = |v: &serde_json::Value| v.as_f64().unwrap_or(f64::NAN);
-            let nu = num(&scene["fluid"]["viscosity"]) / num(&scene["fluid"]["density"]);
+            let nu = fluid_property(scene, "viscosity") / fluid_property(scene, "density");
             let case = capillarity::Capillary::Oscillating { radius, sigma, density, nu };
             capillarity::compute(dim, &case, probes)?
         }
@@ -86,6 +85,12 @@ pub fn rel_errors(values: &[f64], reference: &[f64]) -> Vec<f64> {
 /// Largest pointwise relative error; NaN if any sample is not finite or the series is empty.
 pub fn rel_err_max(values: &[f64], reference: &[f64]) -> f64 {
     nan_max(&rel_errors(values, reference))
+}
+
+/// A number of the scene's `fluid` (`density`, `viscosity`, ...), NaN when absent, so that a
+/// metric computed from it is NaN and fails its checks rather than passing on a default.
+pub fn fluid_property(scene: &serde_json::Value, key: &str) -> f64 {
+    scene["fluid"][key].as_f64().unwrap_or(f64::NAN)
 }
 
 /// Relative error at the last sample (NaN when empty).
