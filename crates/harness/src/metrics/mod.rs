@@ -101,19 +101,24 @@ pub fn rel_err_final(values: &[f64], reference: &[f64]) -> f64 {
     }
 }
 
+/// The ratios `values / reference` at the samples in the last `fraction` of the time span
+/// (none when `t` is empty).
+fn late_ratios(t: &[f64], values: &[f64], reference: &[f64], fraction: f64) -> Vec<f64> {
+    let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else { return Vec::new() };
+    let from = t1 - fraction * (t1 - t0);
+    t.iter()
+        .zip(values.iter().zip(reference))
+        .filter(|(ti, _)| **ti >= from)
+        .map(|(_, (v, r))| v / r)
+        .collect()
+}
+
 /// Relative error of an oscillating quantity judged over the late history: the mean of
 /// `values / reference` over the samples in the last `fraction` of the time span, minus 1,
 /// in absolute value (one sample of an oscillation is a draw, its window mean is not). NaN
 /// when a sample in the window is, or there is none.
 pub fn rel_err_late(t: &[f64], values: &[f64], reference: &[f64], fraction: f64) -> f64 {
-    let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else { return f64::NAN };
-    let from = t1 - fraction * (t1 - t0);
-    let ratios: Vec<f64> = t
-        .iter()
-        .zip(values.iter().zip(reference))
-        .filter(|(ti, _)| **ti >= from)
-        .map(|(_, (v, r))| v / r)
-        .collect();
+    let ratios = late_ratios(t, values, reference, fraction);
     if ratios.is_empty() {
         return f64::NAN;
     }
@@ -124,14 +129,8 @@ pub fn rel_err_late(t: &[f64], values: &[f64], reference: &[f64], fraction: f64)
 /// last `fraction` of the time span (an oscillating quantity held over a window, not read
 /// at one instant). NaN when a sample in the window is, or there is none.
 pub fn rel_err_max_late(t: &[f64], values: &[f64], reference: &[f64], fraction: f64) -> f64 {
-    let (Some(&t0), Some(&t1)) = (t.first(), t.last()) else { return f64::NAN };
-    let from = t1 - fraction * (t1 - t0);
-    let errors: Vec<f64> = t
-        .iter()
-        .zip(values.iter().zip(reference))
-        .filter(|(ti, _)| **ti >= from)
-        .map(|(_, (v, r))| ((v - r) / r).abs())
-        .collect();
+    let errors: Vec<f64> =
+        late_ratios(t, values, reference, fraction).iter().map(|q| (q - 1.0).abs()).collect();
     nan_max(&errors)
 }
 
