@@ -430,8 +430,9 @@ impl Case {
         self.sweep.dx.values().chain(own.flat_map(|d| d.values())).flatten().copied()
     }
 
-    /// Spacings run in `tier` by the preset `select` names (by any preset when it names none).
-    fn selected_spacings(&self, preset: Option<&str>, tier: Tier) -> Vec<f64> {
+    /// Spacings run in `tier` by the preset `preset` (by any preset when `None`), coarse to
+    /// fine, each once.
+    pub fn selected_spacings(&self, preset: Option<&str>, tier: Tier) -> Vec<f64> {
         let mut dx: Vec<f64> = self
             .presets(tier)
             .filter(|p| preset.is_none_or(|n| n == p.name))

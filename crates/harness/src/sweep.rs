@@ -158,10 +158,7 @@ pub fn expand(case: &Case, tier: Tier) -> Result<Vec<RunSpec>> {
     }
     let presets: Vec<&crate::case::Preset> = case.presets(tier).collect();
     // The union of the presets' spacings (a preset may have its own, `presets[].dx`).
-    let mut dx: Vec<f64> =
-        presets.iter().flat_map(|p| case.preset_spacings(p, tier).iter().copied()).collect();
-    dx.sort_by(|a, b| b.total_cmp(a));
-    dx.dedup_by(|a, b| same_spacing(*a, *b));
+    let dx = case.selected_spacings(None, tier);
     let mut out = Vec::with_capacity(dx.len() * presets.len());
     for &d in &dx {
         for p in presets.iter().filter(|p| case.preset_spacings(p, tier).iter().any(|&s| same_spacing(s, d)))
