@@ -8,7 +8,8 @@
 //! `inlet_sources` (inflow only) → `boundary_links` (walls or open boundaries: the
 //! boundary map) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
 //! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) or `surface_pressure`
-//! (σ > 0, `young_laplace`: p = σκ on the free surface) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
+//! (σ > 0, `young_laplace`: p = σκ on the free surface; after `surface_extrapolation`,
+//! `free_surface_pressure: extrapolated`: p = (Δx/2) ∂p/∂n there) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
 //! `mirror_velocity` | `dummy_velocity` (walls only) → `particle_density` (density
 //! relaxation only) → `ppe_assemble`
 //! (eqs. 10, 12) → `ppe_solve` (eq. 5) → `dummy_pressure` (dummy walls only) →
@@ -32,7 +33,9 @@ use crate::error::{Cause, SceneError};
 use crate::fields::{ColumnMut, ColumnRef, Field, Fields};
 use crate::kernel::{Kernel, Scaled};
 use crate::linalg::LinearSolver;
-use crate::scene::{Divergence, IsphOptions, PressureGradient, Probe, Scene, Scheme as SceneScheme};
+use crate::scene::{
+    Divergence, FreeSurfacePressure, IsphOptions, PressureGradient, Probe, Scene, Scheme as SceneScheme,
+};
 use crate::scene::{ViscousIntegration, ViscousOperator, WallModel};
 use crate::scheme::{Adaptive, Composed, Scheme};
 use crate::stage::{Stage, StepContext};
@@ -40,6 +43,7 @@ use crate::stages::boundary_links::BoundaryLinks;
 use crate::stages::dummy::{DummyWalls, Extrapolate};
 use crate::stages::neighbours::{Neighbours, Rows};
 use crate::stages::open_boundary::{InletSources, OpenBoundaries, OpenSetup};
+use crate::stages::surface_extrapolation::SurfaceExtrapolation;
 use crate::stages::surface_tension::{Force, SurfaceTension};
 use crate::stages::young_laplace::SurfacePressure;
 use crate::stages::{free_surface::FreeSurface, reorder::Reorder, shifting, walls};
@@ -183,9 +187,15 @@ fn build_stages<K: Kernel, const D: usize>(
     let sigma = scene.fluid.surface_tension;
     let force = Force::of(scene.fluid.surface_tension_model);
     let young_laplace = sigma > 0.0 && force.is_none();
-    if young_laplace {
-        stages.push(Box::new(SurfacePressure::new(sigma, scene.fluid.surface_tension_threshold, kernel)));
+    let extrapolated = opts.free_surface_pressure == FreeSurfacePressure::Extrapolated;
+    if extrapolated {
+        stages.push(Box::new(SurfaceExtrapolation::default()));
     }
+    if young_laplace {
+        let stage = SurfacePressure::new(sigma, scene.fluid.surface_tension_threshold, kernel);
+        stages.push(Box::new(if extrapolated { stage.adding() } else { stage }));
+    }
+    let surface_pressure = young_laplace || extrapolated;
     if let Some(force) = force.filter(|_| sigma > 0.0) {
         stages.push(Box::new(SurfaceTension::new(
             crate::stages::surface_tension::effective_sigma(scene, &kernel),
@@ -210,12 +220,12 @@ fn build_stages<K: Kernel, const D: usize>(
         divergence: opts.divergence,
         relaxation,
         dt_max: 0.0,
-        surface_pressure: young_laplace,
+        surface_pressure,
     }));
     // Only a `solver` probe reads the measured residual.
     let solver = LinearSolver::new(crate::ppe::solver_params(&opts.ppe))
         .measuring_residual(scene.probes.iter().any(|p| matches!(p, Probe::Solver {})));
-    stages.push(Box::new(projection::PpeSolveStage { solver, surface_pressure: young_laplace }));
+    stages.push(Box::new(projection::PpeSolveStage { solver, surface_pressure }));
     if walls == Some(WallModel::Dummy) {
         stages.push(Box::new(DummyWalls::new(kernel, g, Extrapolate::Pressure)));
     }

@@ -627,6 +627,9 @@ pub struct IsphOptions {
     /// Discrete operator of the viscous term.
     #[serde(default)]
     pub viscous_operator: ViscousOperator,
+    /// The Dirichlet value of the free-surface particles (default `zero`, Qiu eq. 16).
+    #[serde(default, skip_serializing_if = "FreeSurfacePressure::is_zero")]
+    pub free_surface_pressure: FreeSurfacePressure,
 }
 
 impl IsphOptions {
@@ -682,6 +685,27 @@ pub enum ViscousIntegration {
     Explicit,
     /// Backward Euler, one sparse solve per component; no viscous time-step limit.
     Implicit,
+}
+
+/// The pressure the projection imposes on its free-surface particles.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum FreeSurfacePressure {
+    /// `p = 0` on the particles themselves (Qiu 2013 eq. 16), which sit about Δx/2
+    /// inside the surface of the volume they represent.
+    #[default]
+    Zero,
+    /// `p = 0` at the surface, Δx/2 outside the particles: each free-surface particle
+    /// carries `p_a = (Δx/2) n̂_a·∇p_a`, the linear extrapolation of the previous step's
+    /// pressure (`stages::surface_extrapolation`).
+    Extrapolated,
+}
+
+impl FreeSurfacePressure {
+    /// Whether this is the default (`zero`, left out of a written scene).
+    pub fn is_zero(&self) -> bool {
+        *self == FreeSurfacePressure::Zero
+    }
 }
 
 /// Velocity-divergence operator of the PPE source term.

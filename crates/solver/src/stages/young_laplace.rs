@@ -51,13 +51,21 @@ pub struct SurfacePressure<K: Kernel, const D: usize> {
     normal: Vec<Vector<D>>,
     /// Curvature of the free-surface particles \[1/m\] (NaN elsewhere or unmeasured).
     kappa: Vec<f64>,
+    /// Add `σ κ` to the free-surface pressure already set (by
+    /// `stages::surface_extrapolation`) instead of replacing it.
+    adds: bool,
 }
 
 impl<K: Kernel, const D: usize> SurfacePressure<K, D> {
     /// A stage with coefficient `sigma` \[N/m\] and the normal threshold
     /// `ε = threshold / h`.
     pub fn new(sigma: f64, threshold: f64, kernel: Scaled<K, D>) -> Self {
-        Self { sigma, eps: threshold / kernel.h, kernel, normal: Vec::new(), kappa: Vec::new() }
+        Self { sigma, eps: threshold / kernel.h, kernel, normal: Vec::new(), kappa: Vec::new(), adds: false }
+    }
+
+    /// The same stage adding `σ κ` to the free-surface pressure set before it.
+    pub fn adding(self) -> Self {
+        Self { adds: true, ..self }
     }
 }
 
@@ -135,11 +143,12 @@ impl<K: Kernel, const D: usize, O> Stage<D, O> for SurfacePressure<K, D> {
         // κ is the sum of the D − 1 principal curvatures: each at most 1/Δx, each radius
         // grown by Δx/2 to the surface.
         let (sigma, half, m) = (self.sigma, 0.5 * s.dx, (D - 1) as f64);
-        let (kappa, fs) = (&self.kappa, &s.particles.free_surface);
+        let (kappa, fs, adds) = (&self.kappa, &s.particles.free_surface, self.adds);
         s.particles.p[..nf].par_iter_mut().enumerate().with_min_len(1024).for_each(|(a, p)| {
             if fs[a] {
                 let k = kappa[a].clamp(-0.5 * m / half, 0.5 * m / half);
-                *p = if k.is_finite() { sigma * k / (1.0 + k * half / m) } else { 0.0 };
+                let surface = if k.is_finite() { sigma * k / (1.0 + k * half / m) } else { 0.0 };
+                *p = if adds { *p + surface } else { surface };
             }
         });
         Ok(())
