@@ -1,4 +1,4 @@
-//! Per-particle fields declared once ([`particle_fields!`]): every operation that must
+//! Per-particle fields declared once ([`particle_fields!`](crate::particle_fields)): every operation that must
 //! touch every per-particle array — the cell reorder's permutation, the open boundaries'
 //! compaction, the profiler's snapshot and restore, the last-good copy and the frames
 //! written as VTK — visits the arrays a declaration lists, so a field added to a
@@ -60,7 +60,7 @@ pub struct Field<C> {
 }
 
 /// A set of per-particle arrays, visited in declaration order (written by
-/// [`particle_fields!`]; a hand-written implementation must visit every array).
+/// [`particle_fields!`](crate::particle_fields); a hand-written implementation must visit every array).
 pub trait Fields<const D: usize> {
     /// Calls `f` with every array.
     fn visit(&self, f: &mut dyn FnMut(Field<ColumnRef<'_, D>>));

@@ -6,8 +6,8 @@ use crate::error::Cause;
 use crate::scene::Scene;
 use crate::state::{State, Vector};
 
-/// The end-of-step checks of a run ([`Guard::check`]): finite values, the [`GuardBox`], no
-/// overstep beyond the kernel `support`, the [`NeighbourBand`].
+/// The end-of-step checks of a run ([`Guard::check`]): finite values, the `GuardBox`, no
+/// overstep beyond the kernel `support`, the `NeighbourBand`.
 #[derive(Debug, Clone, Copy)]
 pub struct Guard<const D: usize> {
     guard_box: GuardBox<D>,
@@ -31,11 +31,11 @@ impl<const D: usize> Guard<D> {
     }
 
     /// End-of-step checks, in this order of precedence: every position, velocity and
-    /// pressure is finite; no particle left the [`GuardBox`] at `time` \[s\]; no two fluid
+    /// pressure is finite; no particle left the `GuardBox` at `time` \[s\]; no two fluid
     /// neighbours move farther than the kernel support relative to each other in a step of
     /// `dt` \[s\] (the neighbour lists could not follow them: a fixed step far beyond the
     /// CFL limit; Galilean invariant, so a fast but rigid motion passes); no fluid particle has more neighbours than the
-    /// [`NeighbourBand`] allows. The cause names the lowest particle id that failed the
+    /// `NeighbourBand` allows. The cause names the lowest particle id that failed the
     /// most severe check and how many others failed it too.
     pub fn check(&self, state: &State<D>, time: f64, dt: f64) -> Result<(), Cause> {
         use rayon::prelude::*;

@@ -23,7 +23,7 @@ struct Point<'a> {
 /// The cost per particle-step of each named series of the drop (its presets: `paper`,
 /// `tuned`, `wcsph_tuned`, `mps`) and of the channel (`re4`, `re4_implicit`, the MPS
 /// point), over their finished runs with the study's main thread count: the drop's first,
-/// each case's by scheme ([`SCHEMES`]) and then in the order run.
+/// each case's by scheme (`SCHEMES`) and then in the order run.
 pub fn scheme_costs(study: &Study) -> Vec<SchemeCost> {
     let main = |ok: bool, threads: usize| ok && threads == study.threads;
     let drop = study.runs.iter().filter(|r| main(r.ok(), r.threads)).filter_map(|r| {

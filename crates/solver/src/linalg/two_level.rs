@@ -104,7 +104,7 @@ struct ApplyScratch {
 
 /// The coarse space of the two-level preconditioner, kept across solves (see the module
 /// documentation): aggregates keyed by a stable key per row and the factor of `A_c`,
-/// rebuilt every `refresh` solves, or sooner when a solve shows it [`degraded`].
+/// rebuilt every `refresh` solves, or sooner when a solve shows it `degraded`.
 #[derive(Debug)]
 pub struct CoarseSpace {
     refresh: usize,
@@ -112,7 +112,7 @@ pub struct CoarseSpace {
     age: usize,
     /// Krylov iterations of the first solve after the last rebuild.
     fresh_iterations: usize,
-    /// Whether a solve since the last rebuild took [`degraded`] iterations.
+    /// Whether a solve since the last rebuild took `degraded` iterations.
     degraded: bool,
     /// Whether the last rebuild grounded coarse unknown 0 (a singular system).
     grounded: bool,
@@ -181,7 +181,7 @@ impl CoarseSpace {
 
     /// Readies the coarse space for a solve of `a`: rebuilds it when there is none yet (or
     /// the last one could not be factorised), when `refresh` solves have passed since the
-    /// last rebuild, when a solve since then showed it [`degraded`], when the system's
+    /// last rebuild, when a solve since then showed it `degraded`, when the system's
     /// kind (singular or not) changed, or when there are no `keys` (then every solve
     /// rebuilds); otherwise maps the current
     /// rows to the kept aggregates through `keys` (one per row). Returns whether a coarse
@@ -219,7 +219,7 @@ impl CoarseSpace {
     }
 
     /// Records the Krylov iterations of the solve just preconditioned: the first solve
-    /// after a rebuild sets the reference, and a later one that took [`degraded`]
+    /// after a rebuild sets the reference, and a later one that took `degraded`
     /// iterations schedules a rebuild for the next solve.
     pub fn record(&mut self, iterations: usize) {
         if self.age == 1 {

@@ -23,8 +23,8 @@
 //! integral of a flat lattice surface ([`flat_surface_delta`], ≈ 0.5).
 //!
 //! Volumes are `V_b = m/ρ_b` for the weakly compressible scheme and `Δx^D` for ISPH. The
-//! acceleration is added to the WCSPH acceleration ([`Apply::Acceleration`]) or applied to
-//! the ISPH predicted velocity as `u* += Δt a` ([`Apply::Velocity`]).
+//! acceleration is added to the WCSPH acceleration (its `Stage` in `wcsph`) or applied to
+//! the ISPH predicted velocity as `u* += Δt a` (its `Stage` in `isph`).
 
 use crate::kernel::{Kernel, Scaled};
 use crate::scene::SurfaceTensionModel;

@@ -33,7 +33,7 @@ use crate::state::{State, Vector};
 use nalgebra::SMatrix;
 use rayon::prelude::*;
 
-/// Physical and numerical parameters of [`Forces`].
+/// Physical and numerical parameters of the force stages ([`momentum`], [`continuity`]).
 #[derive(Debug, Clone, Copy)]
 pub struct ForceParams<const D: usize> {
     /// Equation of state.
