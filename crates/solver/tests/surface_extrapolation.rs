@@ -1,5 +1,6 @@
 //! The free-surface pressure placed at the surface (`scheme.isph.free_surface_pressure:
-//! extrapolated`): the Dirichlet value of the surface particles and the scene rule.
+//! extrapolated`): the Dirichlet value of the surface particles, that the solve keeps it,
+//! that Young–Laplace adds to it, and the scene rules.
 
 use meniscus::Scene;
 use meniscus::profile::Stepper;
@@ -70,8 +71,9 @@ fn surface_particles_carry_the_linear_extrapolation_to_the_surface() {
 #[test]
 fn extrapolated_surface_pressure_needs_a_difference_form_gradient() {
     // The symmetric gradient adds p_a Σ_b V_b ∇_aW_ab on a surface particle whose pressure
-    // is not zero: an outward push (measured on the elliptical drop: a error 0.33 %
-    // against 0.20 % at Δx = 0.02).
+    // is not zero: an outward push (measured on the elliptical drop: semi-axis a 0.33 %
+    // off against 0.20 % at Δx = 0.02). Without the kernel-gradient correction the plain
+    // gradient sees about half of ∂p/∂n on a surface row.
     let err = Scene::from_json(&block("symmetric").to_string()).expect_err("rejected").to_string();
     assert!(
         err.contains("scheme.isph.free_surface_pressure")
@@ -81,5 +83,114 @@ fn extrapolated_surface_pressure_needs_a_difference_form_gradient() {
     );
     for gradient in ["difference", "corrected"] {
         Scene::from_json(&block(gradient).to_string()).expect("valid scene");
+    }
+    let mut plain = block("difference");
+    plain["scheme"]["isph"]["divergence"] = json!("standard");
+    let err = Scene::from_json(&plain.to_string()).expect_err("rejected").to_string();
+    assert!(err.contains("scheme.isph.free_surface_pressure") && err.contains("correction"), "{err}");
+}
+
+/// The free-surface values of the stepper's state.
+fn surface_values(st: &Stepper<2>) -> Vec<(usize, f64)> {
+    let s = st.state();
+    (0..s.particles.fluid).filter(|&a| s.particles.free_surface[a]).map(|a| (a, s.particles.p[a])).collect()
+}
+
+#[test]
+fn the_solve_keeps_the_extrapolated_values() {
+    // The PPE takes them as known values: after the solve the surface particles hold what
+    // the stage set, and the interior moved (the block's pressure starts 1 cm too high).
+    let scene = Scene::from_json(&block("corrected").to_string()).expect("valid scene");
+    let mut st = Stepper::<2>::new(&scene).expect("builds");
+    let ctx = st.begin_step().expect("step");
+    let set = st.stage_index("surface_extrapolation").expect("stage built") + 1;
+    st.run_stages_before(set, &ctx).expect("runs");
+    let before = surface_values(&st);
+    let interior = st.state().particles.p.clone();
+    let solve = st.stage_index("ppe_solve").expect("stage built");
+    (set..=solve).try_for_each(|i| st.run_stage(i, &ctx)).expect("runs");
+    assert_eq!(surface_values(&st), before);
+    let s = st.state();
+    let moved = (0..s.particles.fluid)
+        .filter(|&a| !s.particles.free_surface[a] && (s.particles.p[a] - interior[a]).abs() > 1e-6);
+    assert!(moved.count() > s.particles.fluid / 2, "the interior was not solved for");
+}
+
+#[test]
+fn young_laplace_adds_sigma_kappa_to_the_extrapolated_value() {
+    // The static drop of tests/young_laplace.rs (R = 0.2, σ = 1, Δx = R/10, corrected
+    // divergence) from a parabolic pressure, with and without the extrapolation: on the
+    // first step the curvature does not depend on it, so the two surface values differ by
+    // exactly the extrapolated one.
+    let drop = |mode: &str| {
+        let v = json!({
+            "name": "drop", "dimension": 2, "dx": 0.02,
+            "kernel": { "kind": "cubic_spline", "h_over_dx": 1.8 },
+            "fluid": { "density": 1.0, "viscosity": 0.5, "surface_tension": 1.0,
+                       "surface_tension_model": "young_laplace", "surface_tension_threshold": 0.1 },
+            "bodies": [ { "role": "fluid", "shape": { "circle": { "center": [0.0, 0.0], "radius": 0.2 } },
+                          "pressure": { "quadratic": { "center": [0.0, 0.0], "value": 5.0,
+                                                       "hessian": [[-50.0, 0.0], [0.0, -50.0]] } } } ],
+            "scheme": { "isph": { "ppe": { "solver": "cg", "tolerance": 1e-8, "max_iterations": 2000 },
+                                  "pressure_gradient": "difference", "divergence": "corrected",
+                                  "viscosity": "implicit", "free_surface_pressure": mode } },
+            "time": { "end": 0.1, "step": { "adaptive": { "cfl": 0.25, "max": 1e-3 } } }
+        });
+        Stepper::<2>::new(&Scene::from_json(&v.to_string()).expect("valid scene")).expect("builds")
+    };
+    let (mut with, mut without) = (drop("extrapolated"), drop("zero"));
+    let ctx = with.begin_step().expect("step");
+    let extrapolated = with.stage_index("surface_extrapolation").expect("stage built") + 1;
+    with.run_stages_before(extrapolated, &ctx).expect("runs");
+    let offset = surface_values(&with);
+    let yl = with.stage_index("surface_pressure").expect("stage built");
+    (extrapolated..=yl).try_for_each(|i| with.run_stage(i, &ctx)).expect("runs");
+    let total = surface_values(&with);
+    let yl0 = without.stage_index("surface_pressure").expect("stage built");
+    without.run_stages_before(yl0 + 1, &ctx).expect("runs");
+    let sigma_kappa = surface_values(&without);
+    assert!(offset.len() > 30, "{} surface particles", offset.len());
+    // p = 5 − 25 r²: ∂p/∂n = 50 r ≈ 10 Pa/m inward at the rim, (Δx/2) ∂p/∂n ≈ 0.1 Pa.
+    assert!(offset.iter().any(|&(_, p)| p > 0.05), "{offset:?}");
+    for ((a, o), ((b, t), (c, k))) in offset.iter().zip(total.iter().zip(&sigma_kappa)) {
+        assert!(a == b && b == c, "the same particles");
+        assert!((t - (o + k)).abs() < 1e-12, "particle {a}: {t} against {o} + {k}");
+    }
+}
+
+#[test]
+fn mirror_walls_see_the_surface_values_through_their_mirrors() {
+    // The block at rest between mirror walls (x = 0 and 0.2), free above and below, no
+    // gravity, from p = ½ H (y − 0.5)²: the surface rows' extrapolated values do not depend
+    // on x, div u* = 0, so the solve's interior pressure (harmonic, ∂p/∂n = 0 at the walls)
+    // does not either — also next to the walls, where the Laplacian reads the surface
+    // values through the mirrors of the surface particles.
+    let mut v = block("corrected");
+    v["body_force"] = json!([0.0, 0.0]);
+    v["bodies"][0]["pressure"] = json!({ "quadratic": { "center": [0.1, 0.5], "value": 0.0, "hessian": [[0.0, 0.0], [0.0, 2000.0]] } });
+    v["boundaries"] = json!({ "walls": [ { "axis": 0, "position": 0.0, "fluid_side": "above" },
+                                         { "axis": 0, "position": 0.2, "fluid_side": "below" } ] });
+    let scene = Scene::from_json(&v.to_string()).expect("valid scene");
+    let mut st = Stepper::<2>::new(&scene).expect("builds");
+    let ctx = st.begin_step().expect("step");
+    let solve = st.stage_index("ppe_solve").expect("stage built");
+    st.run_stages_before(solve + 1, &ctx).expect("runs");
+    let s = st.state();
+    // The top row's value: (Δx/2) H (0.5 − y) ≈ 1 Pa.
+    let top: Vec<f64> = surface_values(&st)
+        .into_iter()
+        .filter(|&(a, _)| s.particles.x[a][1] > 0.1 - DX)
+        .map(|(_, p)| p)
+        .collect();
+    assert!(top.iter().all(|&p| (p - top[0]).abs() < 1e-9 && p > 0.5), "{top:?}");
+    for row in 1..19 {
+        let y = (row as f64 + 0.5) * DX;
+        let p: Vec<f64> = (0..s.particles.fluid)
+            .filter(|&a| (s.particles.x[a][1] - y).abs() < 0.25 * DX)
+            .map(|a| s.particles.p[a])
+            .collect();
+        assert_eq!(p.len(), 40, "row {row}");
+        let (lo, hi) = p.iter().fold((f64::MAX, f64::MIN), |(l, h), &x| (l.min(x), h.max(x)));
+        assert!(hi - lo < 1e-6 * top[0], "row {row}: p from {lo} to {hi} Pa");
     }
 }

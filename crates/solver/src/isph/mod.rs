@@ -7,9 +7,10 @@
 //! extrapolation) →
 //! `inlet_sources` (inflow only) → `boundary_links` (walls or open boundaries: the
 //! boundary map) → `free_surface` (eq. 16) → `viscosity` (eqs. 4, 13; explicit, μ > 0 only) → `body_force`
-//! (eq. 4; g ≠ 0 only) → `surface_tension` (σ > 0 only: u* += Δt a_st) or `surface_pressure`
-//! (σ > 0, `young_laplace`: p = σκ on the free surface; after `surface_extrapolation`,
-//! `free_surface_pressure: extrapolated`: p = (Δx/2) ∂p/∂n there) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
+//! (eq. 4; g ≠ 0 only) → `surface_extrapolation` (`free_surface_pressure: extrapolated`:
+//! p = (Δx/2) ∂p/∂n on the free surface) → `surface_tension` (σ > 0 only: u* += Δt a_st) or
+//! `surface_pressure` (σ > 0, `young_laplace`: p = σκ on the free surface, added to the
+//! extrapolated value) → `viscosity_implicit` (backward Euler instead of `viscosity`) →
 //! `mirror_velocity` | `dummy_velocity` (walls only) → `particle_density` (density
 //! relaxation only) → `ppe_assemble`
 //! (eqs. 10, 12) → `ppe_solve` (eq. 5) → `dummy_pressure` (dummy walls only) →

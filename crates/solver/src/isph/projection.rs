@@ -34,9 +34,10 @@ pub struct PpeAssemble {
     pub relaxation: Option<f64>,
     /// Largest Δt so far \[s\] (density relaxation).
     pub dt_max: f64,
-    /// The free-surface particles carry known, non-zero pressures (the Young–Laplace
-    /// value σκ of `stages::young_laplace`), moved to the right-hand side like the known
-    /// boundary pressures; otherwise they are 0 and drop out.
+    /// The free-surface particles carry known, non-zero pressures (the extrapolated value
+    /// of `stages::surface_extrapolation` and the Young–Laplace value σκ of
+    /// `stages::young_laplace`), moved to the right-hand side like the known boundary
+    /// pressures; otherwise they are 0 and drop out.
     pub surface_pressure: bool,
 }
 
@@ -93,7 +94,7 @@ impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
         }
         m.resize_entries();
         let (v, rho, shao_lo) = (s.volume, s.density, ShaoLo::new(s.h));
-        let (pairs, moments) = (&s.pairs, &s.moments);
+        let (pairs, moments, links) = (&s.pairs, &s.moments, &s.links);
         let (u, inv_dt, corrected) = (&s.particles.u, 1.0 / ctx.dt, self.divergence == Divergence::Corrected);
         self.dt_max = self.dt_max.max(ctx.dt);
         let (p, density, relaxation, dt_max) =
@@ -127,15 +128,31 @@ impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
             } else {
                 divergence(u, a, row_pairs, nbrs, v)
             };
-            // Known boundary pressures (dummy walls) move to the right-hand side.
+            // Known pressures move to the right-hand side: the boundary's (dummy walls, the
+            // outlet buffer) and, with `surface_pressure`, the free surface's, also through a
+            // boundary particle that shares a surface particle's value (a mirror or an inlet
+            // buffer particle: its own p is still the previous step's copy).
             let mut known = 0.0;
             if known_boundary || surface_pressure {
                 for (pr, &b) in pairs[lo..hi].iter().zip(&list.indices[lo..hi]) {
-                    let boundary = b as usize >= n && known_boundary;
-                    let surface = (b as usize) < n && surface_pressure;
-                    if (boundary || surface) && row_of[b as usize] == u32::MAX {
-                        known += shao_lo.coefficient(pr, -2.0 * v, rho) * p[b as usize];
+                    let b = b as usize;
+                    if row_of[b] != u32::MAX {
+                        continue;
                     }
+                    // Follow the shares to the particle that holds the value (a mirror's
+                    // source may be a buffer particle sharing a fluid particle's).
+                    let mut src = b;
+                    while src >= n
+                        && let Link::Shares { source, .. } = links.pressure(src)
+                    {
+                        src = source as usize;
+                    }
+                    let value = match src < n {
+                        true if surface_pressure => p[src],
+                        false if known_boundary => p[src],
+                        _ => continue,
+                    };
+                    known += shao_lo.coefficient(pr, -2.0 * v, rho) * value;
                 }
             }
             let relax = match relaxation {
@@ -151,7 +168,7 @@ impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
 }
 
 /// Solves the assembled PPE (Qiu eq. 5) with the scene's solver, warm-started from the
-/// previous pressure; writes p (zero on the free surface, or the known Young–Laplace
+/// previous pressure; writes p (zero on the free surface, or the known
 /// value there with `surface_pressure`).
 #[derive(Debug)]
 pub struct PpeSolveStage {
@@ -173,7 +190,7 @@ impl<const D: usize> Stage<D, IsphData> for PpeSolveStage {
         let id = &s.particles.id;
         s.solve = sys.solve(&mut self.solver, &s.particles.p, |a| id[a])?;
         let p = &mut s.particles.p;
-        // Free-surface particles get p = 0 (or keep their Young–Laplace value); boundary
+        // Free-surface particles get p = 0 (or keep their known value); boundary
         // particles keep their known values.
         if !self.surface_pressure {
             p[..s.particles.fluid].iter_mut().for_each(|v| *v = 0.0);

@@ -282,14 +282,21 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
         ));
     }
     validate_shifting("scheme.isph.shifting", o.shifting)?;
-    if o.free_surface_pressure == FreeSurfacePressure::Extrapolated
-        && o.pressure_gradient == PressureGradient::Symmetric
-    {
-        return Err(SceneError::new(
-            "scheme.isph.free_surface_pressure",
-            "extrapolated",
-            "needs scheme.isph.pressure_gradient = \"difference\" or \"corrected\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)",
-        ));
+    if o.free_surface_pressure == FreeSurfacePressure::Extrapolated {
+        if o.pressure_gradient == PressureGradient::Symmetric {
+            return Err(SceneError::new(
+                "scheme.isph.free_surface_pressure",
+                "extrapolated",
+                "needs scheme.isph.pressure_gradient = \"difference\" or \"corrected\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)",
+            ));
+        }
+        if o.pressure_gradient != PressureGradient::Corrected && o.divergence != Divergence::Corrected {
+            return Err(SceneError::new(
+                "scheme.isph.free_surface_pressure",
+                "extrapolated",
+                "needs the kernel-gradient correction (scheme.isph.divergence or pressure_gradient = \"corrected\"): the plain gradient sees about half of ∂p/∂n on a surface row",
+            ));
+        }
     }
     Ok(())
 }
