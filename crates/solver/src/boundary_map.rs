@@ -95,6 +95,17 @@ impl BoundaryMap {
         self.pressure.contains(&Link::Known)
     }
 
+    /// The particle that holds particle `b`'s pressure: `b` itself unless its pressure is
+    /// a copy, else the end of the chain of copies (a mirror's source may be a buffer
+    /// particle sharing a fluid particle's).
+    pub fn pressure_holder(&self, b: usize) -> usize {
+        let mut b = b;
+        while let Link::Shares { source, .. } = self.pressure(b) {
+            b = source as usize;
+        }
+        b
+    }
+
     /// The boundary particles (index, link) whose pressure is a copy.
     pub fn pressure_copies(&self) -> impl Iterator<Item = (usize, u32)> + '_ {
         self.pressure.iter().enumerate().filter_map(move |(k, l)| match *l {

@@ -139,20 +139,10 @@ impl<const D: usize> Stage<D, IsphData> for PpeAssemble {
                     if row_of[b] != u32::MAX {
                         continue;
                     }
-                    // Follow the shares to the particle that holds the value (a mirror's
-                    // source may be a buffer particle sharing a fluid particle's).
-                    let mut src = b;
-                    while src >= n
-                        && let Link::Shares { source, .. } = links.pressure(src)
-                    {
-                        src = source as usize;
+                    let src = links.pressure_holder(b);
+                    if (src < n && surface_pressure) || (src >= n && known_boundary) {
+                        known += shao_lo.coefficient(pr, -2.0 * v, rho) * p[src];
                     }
-                    let value = match src < n {
-                        true if surface_pressure => p[src],
-                        false if known_boundary => p[src],
-                        _ => continue,
-                    };
-                    known += shao_lo.coefficient(pr, -2.0 * v, rho) * value;
                 }
             }
             let relax = match relaxation {

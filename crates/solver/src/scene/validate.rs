@@ -284,11 +284,7 @@ fn validate_isph(o: &IsphOptions, d: usize) -> Result<(), SceneError> {
     validate_shifting("scheme.isph.shifting", o.shifting)?;
     if o.free_surface_pressure == FreeSurfacePressure::Extrapolated {
         if o.pressure_gradient == PressureGradient::Symmetric {
-            return Err(SceneError::new(
-                "scheme.isph.free_surface_pressure",
-                "extrapolated",
-                "needs scheme.isph.pressure_gradient = \"difference\" or \"corrected\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)",
-            ));
+            return Err(SceneError::new("scheme.isph.free_surface_pressure", "extrapolated", NOT_SYMMETRIC));
         }
         if o.pressure_gradient != PressureGradient::Corrected && o.divergence != Divergence::Corrected {
             return Err(SceneError::new(
@@ -647,6 +643,11 @@ fn matrix(field: &str, m: &[Vec<f64>], d: usize) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// The rule of a non-zero free-surface pressure (Young–Laplace, extrapolated) on the
+/// pressure gradient: the symmetric form adds `2 p_a Σ V ∇W`, an outward push on surface
+/// particles whose pressure is not zero.
+const NOT_SYMMETRIC: &str = "needs scheme.isph.pressure_gradient = \"difference\" or \"corrected\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)";
+
 /// `fluid.surface_tension_model: young_laplace` sets the free-surface pressure of the
 /// projection, so it needs the ISPH scheme and the difference (or corrected) pressure gradient (the
 /// symmetric form adds `2 p_a Σ V ∇W`, an outward push on surface particles whose pressure
@@ -659,11 +660,9 @@ fn validate_young_laplace(scene: &Scene) -> Result<(), SceneError> {
     }
     match &scene.scheme {
         Scheme::Isph(o) if o.pressure_gradient != PressureGradient::Symmetric => Ok(()),
-        Scheme::Isph(_) => Err(SceneError::new(
-            "fluid.surface_tension_model",
-            "young_laplace",
-            "needs scheme.isph.pressure_gradient = \"difference\" or \"corrected\" (the symmetric gradient pushes surface particles with p ≠ 0 outward)",
-        )),
+        Scheme::Isph(_) => {
+            Err(SceneError::new("fluid.surface_tension_model", "young_laplace", NOT_SYMMETRIC))
+        }
         Scheme::Wcsph(_) | Scheme::Mps(_) => Err(SceneError::new(
             "fluid.surface_tension_model",
             "young_laplace",
