@@ -24,7 +24,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let out = args.out.unwrap_or_else(|| root.join("reports"));
     let cases = meniscus_harness::case::known_cases(&root.join("validation"))?;
     let baseline = args.baseline.as_deref().map(|dir| Baseline::load(dir, Some(&cases))).transpose()?;
-    let extras = meniscus_harness::stability::extra_page(&out).into_iter().collect();
+    let extras = meniscus_harness::validate::extra_pages(&out);
     let rendered = meniscus_harness::report::render(
         &out,
         &RenderOptions { cases: Some(cases), baseline, extras, elapsed_s: None },

@@ -3,6 +3,7 @@
 
 use anyhow::Context;
 use meniscus_harness::ValidateOptions;
+use meniscus_harness::report::numbers::{check_bound, check_number};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -67,10 +68,10 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         let xfail = meniscus_harness::results::expected_failures(&r.checks);
         eprintln!("{:<24} {:>3} passed {:>3} failed {:>3} expected to fail", r.case, passed, failed, xfail);
         for c in r.checks.iter().filter(|c| !c.pass || c.expected_failure.is_some()) {
-            let value = c.value.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
-            let threshold = c.threshold.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
+            let value = c.value.map_or("n/a".to_string(), |v| check_number(c, v));
+            let bound = check_bound(c);
             let note = c.note.as_deref().map(|n| format!(" [{n}]")).unwrap_or_default();
-            eprintln!("  {} {}: {value} (threshold {threshold}){note}", c.verdict().label(), c.name);
+            eprintln!("  {} {}: {value} (bound {bound}){note}", c.verdict().label(), c.name);
         }
     }
     if let Some(cmp) = &outcome.comparison {
@@ -102,7 +103,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             opts.out.join("stability/index.html").display()
         );
         for c in res.checks.iter().filter(|c| !c.verdict().expected()) {
-            let value = c.value.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
+            let value = c.value.map_or("n/a".to_string(), |v| check_number(c, v));
             let note = c.note.as_deref().map(|n| format!(" [{n}]")).unwrap_or_default();
             eprintln!("  {} {}: {value}{note}", c.verdict().label(), c.name);
         }

@@ -29,6 +29,7 @@
 //! a check.
 
 use crate::fit::fit_power_law;
+pub use crate::results::{CheckKind, Judged, Selector};
 use crate::results::{CheckResult, RunResult};
 use crate::tier::Tier;
 use serde::{Deserialize, Serialize};
@@ -38,27 +39,6 @@ use std::collections::BTreeMap;
 /// file's decimal and a computed `D/36` may differ in the last bits).
 pub fn same_spacing(a: f64, b: f64) -> bool {
     (a - b).abs() <= 1e-9 * a.abs().max(b.abs())
-}
-
-/// Kinds of check.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum CheckKind {
-    /// Every selected run has `metric <= max`.
-    Max,
-    /// Every selected run has `metric >= min`.
-    Min,
-    /// Every selected run has `|metric - value| <= tolerance` (default 0: exact).
-    Equals,
-    /// The metric strictly decreases as dx decreases (per scheme and preset); the value is
-    /// the largest ratio `e(finer)/e(coarser)`, which must be below 1.
-    Decreasing,
-    /// The observed order in dx (least squares in log-log) is at least `min`.
-    Order,
-    /// A quantity that has no reference value settles: its relative change between the two
-    /// finest spacings (per scheme and preset), `|m(finest) − m(next)| / |m(next)|`, is at
-    /// most `max`.
-    FinestChange,
 }
 
 /// A row a check can select and read: a case's run, or a row of a study (the stability
@@ -89,27 +69,6 @@ impl Checked for RunResult {
     }
 }
 
-/// Which runs a check applies to (all fields optional; absent = any).
-#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct Selector {
-    /// Spacing (matched to 1e-9 relative).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub dx: Option<f64>,
-    /// Preset name.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub preset: Option<String>,
-    /// Scheme name.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub scheme: Option<String>,
-    /// Study of a study's row (`dt_max`, ...): a case's runs have none.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub study: Option<String>,
-    /// Case of a study's row: a case's runs have none.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
-    pub case: Option<String>,
-}
-
 impl Selector {
     /// Whether `row` matches.
     pub fn matches(&self, row: &impl Checked) -> bool {
@@ -133,6 +92,16 @@ impl Selector {
             parts.push(s.clone());
         }
         if parts.is_empty() { String::new() } else { format!(" ({})", parts.join(", ")) }
+    }
+}
+
+impl Judged {
+    /// Whether the check bounds `metric` of `run` itself (`max` / `min` / `equals` selecting
+    /// it), as opposed to an order or a trend over spacings.
+    pub fn bounds(&self, metric: &str, run: &RunResult) -> bool {
+        matches!(self.kind, CheckKind::Max | CheckKind::Min | CheckKind::Equals)
+            && self.metric == metric
+            && self.select.matches(run)
     }
 }
 
@@ -265,6 +234,12 @@ impl CheckSpec {
     /// (unless a selected run diverged: that fails). A check that applies but selects no
     /// row fails ("no run matches"): absent data never passes.
     pub fn evaluate<R: Checked>(&self, rows: &[R], tier: Tier) -> Option<CheckResult> {
+        let judges = Judged { metric: self.metric.clone(), kind: self.kind()?, select: self.select.clone() };
+        self.evaluate_unrecorded(rows, tier).map(|r| CheckResult { judges: Some(judges), ..r })
+    }
+
+    /// [`CheckSpec::evaluate`] without the record of what it judges.
+    fn evaluate_unrecorded<R: Checked>(&self, rows: &[R], tier: Tier) -> Option<CheckResult> {
         if !self.applies(tier) {
             return None;
         }
@@ -288,6 +263,7 @@ impl CheckSpec {
                     format!("no run matches the selector{} in tier {tier}", sel.describe())
                 })),
                 expected_failure: self.expected_failure.clone(),
+                judges: None,
             });
         }
         let diverged: Vec<String> = picked.iter().filter_map(|r| r.failure()).collect();
@@ -303,6 +279,7 @@ impl CheckSpec {
                 pass: false,
                 note: None,
                 expected_failure: None,
+                judges: None,
             }),
             r => r,
         };
@@ -368,6 +345,7 @@ fn bound(
         pass,
         note,
         expected_failure: None,
+        judges: None,
     }
 }
 
@@ -460,6 +438,7 @@ fn decreasing(name: &str, runs: &[&RunResult], metric: &str) -> Option<CheckResu
         pass,
         note,
         expected_failure: None,
+        judges: None,
     })
 }
 
@@ -502,6 +481,7 @@ fn order(name: &str, runs: &[&RunResult], metric: &str, min: f64) -> Option<Chec
         pass,
         note,
         expected_failure: None,
+        judges: None,
     })
 }
 
@@ -531,6 +511,7 @@ fn finest_change(name: &str, runs: &[&RunResult], metric: &str, max: f64) -> Opt
         pass: note.is_none() && worst.is_some_and(|w| w <= max),
         note,
         expected_failure: None,
+        judges: None,
     })
 }
 

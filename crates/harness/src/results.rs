@@ -339,6 +339,61 @@ impl Summary {
     }
 }
 
+/// Kinds of check.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CheckKind {
+    /// Every selected run has `metric <= max`.
+    Max,
+    /// Every selected run has `metric >= min`.
+    Min,
+    /// Every selected run has `|metric - value| <= tolerance` (default 0: exact).
+    Equals,
+    /// The metric strictly decreases as dx decreases (per scheme and preset); the value is
+    /// the largest ratio `e(finer)/e(coarser)`, which must be below 1.
+    Decreasing,
+    /// The observed order in dx (least squares in log-log) is at least `min`.
+    Order,
+    /// A quantity that has no reference value settles: its relative change between the two
+    /// finest spacings (per scheme and preset), `|m(finest) − m(next)| / |m(next)|`, is at
+    /// most `max`.
+    FinestChange,
+}
+
+/// Which runs a check applies to (all fields optional; absent = any).
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Selector {
+    /// Spacing (matched to 1e-9 relative).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub dx: Option<f64>,
+    /// Preset name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// Scheme name.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub scheme: Option<String>,
+    /// Study of a study's row (`dt_max`, ...): a case's runs have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub study: Option<String>,
+    /// Case of a study's row: a case's runs have none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub case: Option<String>,
+}
+
+/// What a check judges, recorded in its result (`checks[].judges` of `results.json`) so a
+/// report can tell which values a check judges and write them in the metric's units.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Judged {
+    /// The metric.
+    pub metric: String,
+    /// The kind of check.
+    pub kind: CheckKind,
+    /// The runs it selects.
+    #[serde(default)]
+    pub select: Selector,
+}
+
 /// A check's outcome, as written to `results.json`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct CheckResult {
@@ -357,6 +412,10 @@ pub struct CheckResult {
     /// Why the case file expects it to fail (the scheme's documented shortfall), if it does.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub expected_failure: Option<String>,
+    /// What the check judges (its metric, kind and selector); absent for checks that judge
+    /// no metric (a run's completion) and in results written before it was recorded.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub judges: Option<Judged>,
 }
 
 impl CheckResult {

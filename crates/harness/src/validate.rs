@@ -162,7 +162,7 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     }
     let tally = runner.tally();
     (outcome.executed, outcome.reused) = (tally.executed, tally.reused);
-    let extras = crate::stability::extra_page(&opts.out).into_iter().collect();
+    let extras = extra_pages(&opts.out);
     // The wall time of the last invocation that ran something (a fully cached rerun keeps
     // the previous one).
     let elapsed_s = if tally.executed > 0 {
@@ -176,6 +176,12 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
         report::render(&opts.out, &RenderOptions { cases: Some(known), baseline, extras, elapsed_s })?;
     outcome.comparison = rendered.comparison;
     Ok(outcome)
+}
+
+/// The pages beside the cases that the index links, those present in `out`: the
+/// stability envelope's and the work-precision study's.
+pub fn extra_pages(out: &Path) -> Vec<report::ExtraPage> {
+    crate::stability::extra_page(out).into_iter().chain(crate::work_precision::extra_page(out)).collect()
 }
 
 /// Runs with at least this many particles get every thread of the machine (and run alone,
@@ -275,6 +281,7 @@ pub fn assemble(case: &Case, tier: Tier, runs: Vec<RunResult>) -> CaseResults {
             pass: false,
             note: Some(format!("no check of {} selects a run of tier {tier}", case.case)),
             expected_failure: None,
+            judges: None,
         });
     }
     checks.extend(completion_checks(case, &runs));
@@ -310,6 +317,7 @@ fn completion_checks(case: &Case, runs: &[RunResult]) -> Vec<crate::results::Che
             pass: stopped.is_empty(),
             note: (!stopped.is_empty()).then(|| format!("did not: {}", stopped.join(", "))),
             expected_failure: None,
+            judges: None,
         });
     }
     for r in runs {
@@ -321,6 +329,7 @@ fn completion_checks(case: &Case, runs: &[RunResult]) -> Vec<crate::results::Che
                 pass: r.ok(),
                 note: (!r.ok()).then(|| r.status.clone()),
                 expected_failure: Some(reason.to_string()),
+                judges: None,
             });
         }
     }

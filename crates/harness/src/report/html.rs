@@ -1,33 +1,27 @@
 //! HTML pages (maud): self-contained (inline CSS, no scripts, figures by relative link).
 
 use super::FigureFile;
+use super::header::Header;
+use super::matrix::{Cell, Judgement, Matrix};
+use super::numbers::{check_number, dx_list, format_dx, format_metric, format_order, significant};
 use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
 use crate::case::{CaseRecord, Published};
 use crate::checks::same_spacing;
 use crate::results::{CaseResults, CheckResult, RunResult, Summary, Verdict, expected_failures};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
-const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1200px;color:#222}\
-table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}\
+const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1320px;color:#222}\
+table{border-collapse:collapse;margin:1em 0;max-width:100%}th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}\
 th{background:#f0f0f0}td.l,th.l{text-align:left}.pass{background:#d9f2d9;color:#145214}\
 .fail{background:#f8d7d7;color:#7a1010}pre{background:#f6f6f6;padding:1em;overflow-x:auto;font-size:85%}\
-figure{display:inline-block;margin:0.5em}figcaption{font-size:90%;color:#555}code{font-size:90%}\
+figure{display:inline-block;margin:0.5em;max-width:100%}figure img{max-width:100%;height:auto}\
+figcaption{font-size:90%;color:#555}code{font-size:90%}\
 .better{background:#d9f2d9;color:#145214}.worse{background:#f8d7d7;color:#7a1010}\
 .changed{background:#fff3cd;color:#664d03}.note{color:#555;font-size:90%}\
-.xfail{background:#ececec;color:#444}";
-
-/// Formats a metric: relative errors (`rel_err`, `_l2_rel`, `_linf_rel`) and drifts in
-/// percent, counts as integers.
-pub fn format_metric(name: &str, v: Option<f64>) -> String {
-    let relative = ["rel_err", "_l2_rel", "_linf_rel", "drift"].iter().any(|k| name.contains(k));
-    match v {
-        None => "—".to_string(),
-        Some(x) if !x.is_finite() => "NaN".to_string(),
-        Some(x) if relative => format!("{:.3} %", x * 100.0),
-        Some(x) if x.fract().abs() < 1e-12 && x.abs() < 1e15 => format!("{x:.0}"),
-        Some(x) => format!("{x:.4e}"),
-    }
-}
+.xfail{background:#ececec;color:#444}.info{background:#fff;color:#333;border:1px dashed #aaa}\
+.chip{display:inline-block;padding:1px 6px;border-radius:3px;margin:1px 0}\
+.best{color:#7a5a00;font-weight:bold}td.cell{vertical-align:top;min-width:12em}\
+table.header th{width:8em}small{font-size:80%}";
 
 /// The change of a metric as text: `+12.3 %` of the baseline, or `—` when undefined.
 pub fn format_change(m: &MetricChange) -> String {
@@ -65,15 +59,6 @@ fn speed_class(w: &WallChange) -> &'static str {
     }
 }
 
-/// An observed order as text (`1.73`, `—`).
-pub fn format_order(v: Option<f64>) -> String {
-    match v {
-        Some(x) if x.is_finite() => format!("{x:.2}"),
-        Some(_) => "NaN".to_string(),
-        None => "—".to_string(),
-    }
-}
-
 /// A value that may have moved: the new value, and when it moved the baseline value and
 /// the relative change (`0.095 % (was 0.048 %, +100.0 %)`).
 fn moved_value(m: &MetricChange, fmt: impl Fn(Option<f64>) -> String) -> String {
@@ -96,7 +81,7 @@ fn order_rows(changes: &[MetricChange]) -> Markup {
     }
 }
 
-/// One table of every metric (rows) of every matched run (columns); a moved value shows
+/// Tables of every metric (rows) of every matched run (columns, [`RUN_COLUMNS`] per table); a moved value shows
 /// its baseline and change and is coloured by its mark.
 fn metric_table(case: &CaseComparison) -> Markup {
     let mut names: Vec<&str> = Vec::new();
@@ -109,17 +94,19 @@ fn metric_table(case: &CaseComparison) -> Markup {
     }
     names.sort_unstable();
     html! {
-        table {
-            tr { th class="l" { "metric" } @for r in &case.runs { th { code { (r.slug) } } } }
-            @for n in &names {
-                tr {
-                    td class="l" { code { (n) } }
-                    @for r in &case.runs {
-                        @match r.metrics.iter().find(|m| m.name == *n) {
-                            Some(m) => td class=(mark_class(m.mark)) title=(m.mark.label()) {
-                                (moved_value(m, |v| format_metric(n, v)))
-                            },
-                            None => td { "—" },
+        @for runs in case.runs.chunks(RUN_COLUMNS) {
+            table {
+                tr { th class="l" { "metric" } @for r in runs { th { code { (breakable(&r.slug)) } } } }
+                @for n in &names {
+                    tr {
+                        td class="l" { code { (breakable(n)) } }
+                        @for r in runs {
+                            @match r.metrics.iter().find(|m| m.name == *n) {
+                                Some(m) => td class=(mark_class(m.mark)) title=(m.mark.label()) {
+                                    (moved_value(m, |v| format_metric(n, v)))
+                                },
+                                None => td { "—" },
+                            }
                         }
                     }
                 }
@@ -201,16 +188,17 @@ pub(crate) fn pass_cell(pass: bool) -> Markup {
     html! { td class=(if pass { "pass" } else { "fail" }) { (if pass { "PASS" } else { "FAIL" }) } }
 }
 
-/// The table of checks: name, value and threshold (written by `number`), verdict, note.
-pub(crate) fn checks_table(checks: &[CheckResult], number: fn(f64) -> String) -> Markup {
+/// The table of checks: name, value and threshold (in the form of what each judges,
+/// [`check_number`]), verdict, note.
+pub(crate) fn checks_table(checks: &[CheckResult]) -> Markup {
     html! {
         table {
             tr { th class="l" { "check" } th { "value" } th { "threshold" } th { "result" } th class="l" { "note" } }
             @for c in checks {
                 tr {
                     td class="l" { (c.name) }
-                    td { (c.value.map_or("—".to_string(), number)) }
-                    td { (c.threshold.map_or("—".to_string(), number)) }
+                    td { (c.value.map_or("—".to_string(), |v| check_number(c, v))) }
+                    td { (c.threshold.map_or("—".to_string(), |v| check_number(c, v))) }
                     (verdict_cell(c.verdict()))
                     td class="l" { (check_note(c)) }
                 }
@@ -234,6 +222,13 @@ pub(crate) fn page(title: &str, body: Markup) -> String {
     .into_string()
 }
 
+/// Metric columns per error table: more are split into further tables, so a table fits a
+/// 1400 px wide window.
+const METRIC_COLUMNS: usize = 6;
+
+/// Run columns per table of the baseline comparison's metrics (split like the errors).
+const RUN_COLUMNS: usize = 5;
+
 /// Metric columns of the error table: the case's list, else every metric seen (without
 /// the run fields that have their own columns).
 fn metric_columns(results: &CaseResults, record: Option<&CaseRecord>) -> Vec<String> {
@@ -255,19 +250,7 @@ pub(crate) fn resolutions(runs: &[RunResult]) -> String {
     let mut dx: Vec<f64> = runs.iter().map(|r| r.dx).collect();
     dx.sort_by(|a, b| b.total_cmp(a));
     dx.dedup_by(|a, b| (*a - *b).abs() <= 1e-12 * b.abs());
-    dx.iter().map(|&d| format_dx(d)).collect::<Vec<_>>().join(", ")
-}
-
-/// A spacing as text: as written when short (`0.02`), else to 4 significant digits
-/// Spacings as `0.02, 0.01` ([`format_dx`] each).
-fn dx_list(dx: &[f64]) -> String {
-    dx.iter().map(|&d| format_dx(d)).collect::<Vec<_>>().join(", ")
-}
-
-/// (`5.556e-3` for D/36).
-pub fn format_dx(dx: f64) -> String {
-    let plain = dx.to_string();
-    if plain.len() <= 8 { plain } else { format!("{dx:.3e}") }
+    dx_list(&dx)
 }
 
 /// The page of one case; with a comparison, a "Compared with baseline" section follows the
@@ -289,7 +272,7 @@ pub fn case_page(
             @if !c.description.is_empty() { p { (c.description) } }
         }
         p {
-            "Scheme " code { (results.scheme) } ", tier " code { (results.tier) } ", "
+            "Schemes " code { (schemes(results).join(", ")) } ", tier " code { (results.tier) } ", "
             (results.runs.len()) " runs at dx = " (resolutions(&results.runs)) ". "
             span class=(if failed == 0 { "pass" } else { "fail" }) {
                 (passed) " / " (passed + failed) " checks passed"
@@ -298,26 +281,36 @@ pub fn case_page(
             @if xfail > 0 { " " span class="xfail" { (xfail) " expected failure(s)" } }
         }
         h2 { "Checks" }
-        (checks_table(&results.checks, |v| format!("{v:.4e}")))
+        (checks_table(&results.checks))
         @if let Some(cmp) = comparison {
             @if let Some(case) = cmp.case(&results.case) { (baseline_section(cmp, case)) }
         }
-        h2 { "Errors" }
+        h2 { "Runs" }
         table {
             tr {
                 th class="l" { "run" } th class="l" { "status" } th { "particles" } th { "steps" } th { "wall [s]" }
-                @for m in &columns { th { (m) } }
             }
             @for r in &results.runs {
                 tr {
-                    td class="l" { code { (r.slug()) } }
+                    td class="l" { code { (breakable(&r.slug())) } }
                     @if r.ok() {
                         td class="l pass" {
-                            "ok" @if let Some(t) = r.steady_at { " (steady at t = " (format!("{t:.4e}")) " s)" }
+                            "ok" @if let Some(t) = r.steady_at { " (steady at t = " (significant(t, 4)) " s)" }
                         }
                     } @else { td class="l fail" { (r.status) } }
                     td { (r.particles) } td { (r.steps) } td { (format!("{:.2}", r.wall_s)) }
-                    @for m in &columns { td { (format_metric(m, r.metric(m))) } }
+                }
+            }
+        }
+        h2 { "Errors" }
+        @for chunk in columns.chunks(METRIC_COLUMNS) {
+            table {
+                tr { th class="l" { "run" } @for m in chunk { th { code { (breakable(m)) } } } }
+                @for r in &results.runs {
+                    tr {
+                        td class=(if r.ok() { "l" } else { "l fail" }) { code { (breakable(&r.slug())) } }
+                        @for m in chunk { td { (format_metric(m, r.metric(m))) } }
+                    }
                 }
             }
         }
@@ -417,10 +410,10 @@ fn published_table(published: &[Published], runs: &[RunResult]) -> Markup {
                     });
                     @let measured = run.and_then(|r| r.metric(&p.metric));
                     tr {
-                        td class="l" { (p.source) } td class="l" { code { (p.metric) } }
+                        td class="l" { (p.source) } td class="l" { code { (breakable(&p.metric)) } }
                         td class="l" { (p.preset) } td { (format_dx(*dx)) }
-                        td { (format!("{value:.4e}")) }
-                        td { (measured.map(|m| format!("{m:.4e}")).unwrap_or_default()) }
+                        td { (format_metric(&p.metric, Some(*value))) }
+                        td { (measured.map(|m| format_metric(&p.metric, Some(m))).unwrap_or_default()) }
                         td { (measured.map(|m| format!("{:+.2}%", 100.0 * (m / value - 1.0))).unwrap_or_default()) }
                     }
                 }
@@ -429,69 +422,6 @@ fn published_table(published: &[Published], runs: &[RunResult]) -> Markup {
         @for p in published.iter().filter(|p| !p.note.is_empty()) {
             p class="note" { (p.source) ": " (p.note) }
         }
-    }
-}
-
-/// Key errors of a case for the index: each key metric at the finest spacing of the primary
-/// preset that has a completed run. Where that spacing has perturbed starts, the value is
-/// their mean as the checks and order fits take it ([`crate::checks::per_spacing`]: none
-/// when a start diverged or lacks the metric, and the text says so) with the range of the
-/// starts that have it.
-pub(crate) fn key_errors(results: &CaseResults, record: Option<&CaseRecord>) -> String {
-    let keys: Vec<String> = record.map(|r| r.case.key_metrics.clone()).unwrap_or_default();
-    let primary = record
-        .map(|r| r.case.primary_preset().to_string())
-        .or_else(|| results.runs.first().map(|r| r.preset.clone()));
-    let runs: Vec<&RunResult> = results.runs.iter().filter(|r| Some(&r.preset) == primary.as_ref()).collect();
-    let Some(finest) = runs.iter().filter(|r| r.ok()).map(|r| r.dx).min_by(f64::total_cmp) else {
-        return "—".to_string();
-    };
-    let members: Vec<&RunResult> = runs.into_iter().filter(|r| same_spacing(r.dx, finest)).collect();
-    let first = members.iter().find(|r| r.ok()).copied().unwrap_or(members[0]);
-    let keys = if keys.is_empty() { first.metrics.keys().take(2).cloned().collect() } else { keys };
-    let parts: Vec<String> = keys
-        .iter()
-        .map(|k| {
-            if members.len() == 1 {
-                return format!("{k} {}", format_metric(k, first.metric(k)));
-            }
-            let values: Vec<f64> = members
-                .iter()
-                .filter(|r| r.ok())
-                .filter_map(|r| r.metric(k))
-                .filter(|v| v.is_finite())
-                .collect();
-            let lo = values.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = values.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            let range = if values.is_empty() {
-                String::new()
-            } else {
-                format!(", {} – {}", format_metric(k, Some(lo)), format_metric(k, Some(hi)))
-            };
-            let mean = crate::checks::per_spacing(&members, k).first().and_then(|(_, m)| *m);
-            match mean {
-                Some(m) => {
-                    format!("{k} {} (mean of {} starts{range})", format_metric(k, Some(m)), members.len())
-                }
-                None => format!(
-                    "{k} — ({} of {} starts diverged or lack it{range})",
-                    members.len() - values.len(),
-                    members.len()
-                ),
-            }
-        })
-        .collect();
-    format!("{} ({} dx={})", parts.join(", "), first.preset, format_dx(first.dx))
-}
-
-/// The order shown on the index: the first convergence metric of the case.
-pub(crate) fn key_order(results: &CaseResults, record: Option<&CaseRecord>) -> String {
-    let first = record
-        .and_then(|r| r.case.convergence.iter().find(|m| results.convergence.contains_key(*m)).cloned())
-        .or_else(|| results.convergence.keys().next().cloned());
-    match first.and_then(|m| results.convergence.get(&m).map(|c| (m, c))) {
-        Some((m, c)) => format!("{m}: {:.2}", c.order),
-        None => "—".to_string(),
     }
 }
 
@@ -527,41 +457,188 @@ pub struct ExtraPage {
     pub pass: bool,
 }
 
-/// `reports/index.html`: one row per case (with a comparison, a "vs baseline" column), then
-/// links to the `extras` pages.
+/// The schemes a case runs, in the order its runs name them.
+pub(crate) fn schemes(results: &CaseResults) -> Vec<&str> {
+    let mut out: Vec<&str> = Vec::new();
+    for r in &results.runs {
+        if !out.contains(&r.scheme.as_str()) {
+            out.push(&r.scheme);
+        }
+    }
+    out
+}
+
+/// The CSS class and label of a verdict; `None` (no check judges the value) is
+/// information.
+fn verdict_mark(v: Option<Verdict>) -> (&'static str, &'static str) {
+    match v {
+        Some(Verdict::Pass) => ("pass", "pass"),
+        Some(Verdict::Fail) => ("fail", "FAIL"),
+        Some(Verdict::UnexpectedPass) => ("fail", "UNEXPECTED PASS"),
+        Some(Verdict::ExpectedFail) => ("xfail", "expected fail"),
+        None => ("info", "not judged"),
+    }
+}
+
+/// A judged value: the value in its verdict's colour, the bound beside it and the verdict;
+/// an unjudged one as information.
+fn judged(text: &str, j: &Judgement) -> Markup {
+    let (class, label) = verdict_mark(j.verdict);
+    html! {
+        span class=(format!("chip {class}")) title=(label) {
+            b { (text) }
+            @if !j.bound.is_empty() { " " (j.bound) }
+            " " small { (label) }
+        }
+    }
+}
+
+/// One cell of the scheme-by-case matrix.
+fn matrix_cell(cell: &Cell, metric: Option<&str>) -> Markup {
+    let value = match (cell.value, metric) {
+        (Some(v), Some(m)) => format_metric(m, Some(v)),
+        _ => "— (no completed run)".to_string(),
+    };
+    let tally_class = if cell.tally.failed > 0 { "fail" } else { "pass" };
+    html! {
+        td class="l cell" {
+            div { (judged(&value, &cell.value_check)) @if cell.best { " " span class="best" title="smallest error of the case" { "★ best" } } }
+            div class="note" {
+                (cell.preset) ", dx " (format_dx(cell.dx))
+                @if cell.starts > 1 { " (mean of " (cell.starts) " starts)" }
+                ", " (format!("{:.1}", cell.wall_s)) " s"
+            }
+            @if let Some(o) = cell.order { div { "order " (judged(&format_order(Some(o)), &cell.order_check)) } }
+            div { span class=(format!("chip {tally_class}")) { (cell.tally.describe()) } }
+        }
+    }
+}
+
+/// The scheme-by-case matrix ([`Matrix`]).
+fn matrix_table(m: &Matrix) -> Markup {
+    html! {
+        table class="matrix" {
+            tr {
+                th class="l" { "case" } th class="l" { "headline metric" }
+                @for s in &m.schemes { th class="l" { (s.to_uppercase()) } }
+            }
+            @for row in &m.rows {
+                tr {
+                    td class="l" {
+                        a href=(format!("{}/index.html", row.case)) { (row.case) }
+                        @if !row.title.is_empty() { br; span class="note" { (row.title) } }
+                        br; span class=(if row.pass { "chip pass" } else { "chip fail" }) { (if row.pass { "PASS" } else { "FAIL" }) }
+                    }
+                    td class="l" { code { (breakable(row.metric.as_deref().unwrap_or("—"))) } }
+                    @for c in &row.cells {
+                        @match c {
+                            Some(c) => (matrix_cell(c, row.metric.as_deref())),
+                            None => td class="l note" { "not run" },
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// `text` with a line-break opportunity after each `_` and `-` (long metric names and run
+/// slugs wrap instead of widening their tables).
+pub(crate) fn breakable(text: &str) -> Markup {
+    let mut out = String::new();
+    for ch in text.chars() {
+        match ch {
+            '&' => out.push_str("&amp;"),
+            '<' => out.push_str("&lt;"),
+            '>' => out.push_str("&gt;"),
+            '"' => out.push_str("&quot;"),
+            c => out.push(c),
+        }
+        if ch == '_' || ch == '-' {
+            out.push_str("<wbr>");
+        }
+    }
+    PreEscaped(out)
+}
+
+/// What [`index_page`] shows besides the results.
+pub struct IndexParts<'a> {
+    /// The header's facts.
+    pub header: &'a Header,
+    /// The scheme-by-case matrix.
+    pub matrix: &'a Matrix,
+    /// The overview figure's file (relative to the index), when drawn.
+    pub overview: Option<&'a str>,
+    /// The pages beside the cases.
+    pub extras: &'a [ExtraPage],
+}
+
+/// `reports/index.html`: the header (what ran, when, where, how long; links to every
+/// page), the scheme-by-case matrix, the overview figure, one row per case (with a
+/// comparison, a "vs baseline" column), the run times and the pages beside the cases.
 pub fn index_page(
     results: &[CaseResults],
-    records: &[Option<&CaseRecord>],
     summary: &Summary,
     comparison: Option<&Comparison>,
-    extras: &[ExtraPage],
+    parts: &IndexParts,
 ) -> String {
     let body = html! {
         h1 { "Meniscus validation" }
         p class=(if summary.pass { "pass" } else { "fail" }) {
+            b { (if summary.pass { "PASS" } else { "FAIL" }) } ": "
             (summary.passed) " / " (summary.passed + summary.failed) " checks passed over " (results.len()) " cases"
             @if summary.expected_failures > 0 { ", " (summary.expected_failures) " expected failure(s) apart" }
+        }
+        table class="header" {
+            @for (label, value) in parts.header.lines() {
+                tr { th class="l" { (label) } td class="l" { (value) } }
+            }
+            tr {
+                th class="l" { "pages" }
+                td class="l" {
+                    @for (i, r) in results.iter().enumerate() {
+                        @if i > 0 { " · " }
+                        a href=(format!("{}/index.html", r.case)) { (r.case) }
+                    }
+                    @for e in parts.extras { " · " a href=(e.href) { b { (e.title) } } }
+                }
+            }
         }
         @if let Some(cmp) = comparison {
             p { "Compared with baseline " code { (cmp.baseline.display()) } ": " (cmp.tally().describe()) "." }
             p class="note" { (cmp.band.describe()) }
         }
+        h2 { "Schemes by case" }
+        p class="note" {
+            "Per case and scheme: the best preset's headline error (the case's first key error) at the \
+             finest spacing the scheme ran, in the colour of the checks that bound it, with the bound \
+             (grey: expected to fail; white: no check judges it, information only); its observed \
+             order; the run's wall time; every check that selects the scheme's runs. ★ marks the \
+             scheme with the smallest error of the case."
+        }
+        (matrix_table(parts.matrix))
+        @if let Some(f) = parts.overview {
+            figure {
+                a href=(f) { img src=(f) alt="headline error against wall time, every case and scheme" width="1000"; }
+                figcaption { "Every case's headline error against the wall time of its runs: one colour per case, one marker per scheme, a line through the best preset's spacings (coarse to fine)." }
+            }
+        }
+        h2 { "Cases" }
         table {
             tr {
-                th class="l" { "case" } th class="l" { "scheme" } th class="l" { "tier" } th class="l" { "resolutions (dx)" }
-                th class="l" { "key errors" } th class="l" { "observed order" } th { "wall [s]" } th { "checks" } th { "result" }
+                th class="l" { "case" } th class="l" { "schemes" } th class="l" { "tier" } th class="l" { "resolutions (dx)" }
+                th { "runs" } th { "wall [s]" } th { "checks" } th { "result" }
                 @if comparison.is_some() { th class="l" { "vs baseline" } }
             }
-            @for (i, r) in results.iter().enumerate() {
-                @let rec = records.get(i).copied().flatten();
+            @for r in results {
                 @let (passed, failed) = r.counts();
+                @let diverged = r.runs.iter().filter(|x| !x.ok()).count();
                 tr {
                     td class="l" { a href=(format!("{}/index.html", r.case)) { (r.case) } }
-                    td class="l" { (r.scheme) }
+                    td class="l" { (schemes(r).join(", ")) }
                     td class="l" { (r.tier) }
                     td class="l" { (resolutions(&r.runs)) }
-                    td class="l" { (key_errors(r, rec)) }
-                    td class="l" { (key_order(r, rec)) }
+                    td { (r.runs.len()) @if diverged > 0 { " (" (diverged) " diverged)" } }
                     td { (format!("{:.1}", r.runs.iter().map(|x| x.wall_s).sum::<f64>())) }
                     td {
                         (passed) " / " (passed + failed)
@@ -574,11 +651,11 @@ pub fn index_page(
             }
         }
         (super::timing::html_section(results, summary.elapsed_s))
-        @if !extras.is_empty() {
-            h2 { "Stress tests" }
+        @if !parts.extras.is_empty() {
+            h2 { "Other pages" }
             table {
                 tr { th class="l" { "page" } th class="l" { "what" } th { "result" } }
-                @for e in extras {
+                @for e in parts.extras {
                     tr {
                         td class="l" { a href=(e.href) { (e.title) } }
                         td class="l" { (e.summary) }
@@ -596,58 +673,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn metrics_and_spacings_read_well() {
-        assert_eq!(format_metric("u_profile_l2_rel_steady", Some(0.0095)), "0.950 %");
-        assert_eq!(format_metric("b_rel_err_max", Some(0.001)), "0.100 %");
-        assert_eq!(format_metric("particles", Some(648.0)), "648");
-        assert_eq!(format_metric("min_pair_over_dx_min", Some(0.41579)), "4.1579e-1");
-        assert_eq!(format_dx(0.02), "0.02");
-        assert_eq!(format_dx(0.0025), "0.0025");
-        assert_eq!(format_dx(0.2 / 36.0), "5.556e-3");
-    }
-
-    #[test]
-    fn key_errors_take_the_finest_spacing_and_its_starts_mean() {
-        let run = |dx: f64, start: Option<u64>, err: f64| RunResult {
-            scheme: "isph".into(),
-            preset: "p".into(),
-            dx,
-            start,
-            particles: 100,
-            steps: 10,
-            wall_s: 1.0,
-            cpu_s: None,
-            threads: None,
-            steady_at: None,
-            status: "ok".into(),
-            metrics: [("u_l2_rel".to_string(), err)].into(),
-            series: Default::default(),
-        };
-        let mut results = CaseResults {
-            case: "c".into(),
-            scheme: "isph".into(),
-            tier: "default".into(),
-            runs: vec![run(0.02, None, 0.01), run(0.01, None, 0.002)],
-            convergence: Default::default(),
-            checks: Vec::new(),
-        };
-        assert_eq!(key_errors(&results, None), "u_l2_rel 0.200 % (p dx=0.01)");
-        results.runs.push(run(0.01, Some(1), 0.004));
-        results.runs.push(run(0.01, Some(2), 0.003));
-        assert_eq!(
-            key_errors(&results, None),
-            "u_l2_rel 0.300 % (mean of 3 starts, 0.200 % – 0.400 %) (p dx=0.01)"
-        );
-        // A start that diverged leaves the spacing without a mean, as in the order fits.
-        results.runs[3].status = "diverged".into();
-        assert_eq!(
-            key_errors(&results, None),
-            "u_l2_rel — (1 of 3 starts diverged or lack it, 0.200 % – 0.400 %) (p dx=0.01)"
-        );
-        // Every run at the finest spacing diverged: the next one down is shown.
-        for r in &mut results.runs[1..] {
-            r.status = "diverged".into();
-        }
-        assert_eq!(key_errors(&results, None), "u_l2_rel 1.000 % (p dx=0.02)");
+    fn long_names_break_after_underscores_and_escape() {
+        assert_eq!(breakable("b_rel<x>").into_string(), "b_<wbr>rel&lt;x&gt;");
+        assert_eq!(breakable("isph-paper_dx0.02").into_string(), "isph-<wbr>paper_<wbr>dx0.02");
     }
 }

@@ -1,13 +1,13 @@
 //! `reports/summary.md`: the report in GitHub-flavoured Markdown, for a CI job summary or
-//! a pull-request comment. One row per case (key errors, observed order, wall time,
-//! pass/fail), the failed checks below the table, and with a baseline the regressions
-//! and improvements beyond the noise band.
+//! a pull-request comment. The header, the scheme-by-case matrix ([`Matrix`]), one row per
+//! case, the failed checks below the tables, and with a baseline the regressions and
+//! improvements beyond the noise band.
 
-use super::html::{
-    format_change, format_metric, format_order, format_ratio, key_errors, key_order, resolutions,
-};
+use super::header::Header;
+use super::html::{format_change, format_ratio, resolutions, schemes};
+use super::matrix::{Cell, Judgement, Matrix};
+use super::numbers::{check_number, format_metric, format_order};
 use crate::baseline::{CaseComparison, Comparison, Mark};
-use crate::case::CaseRecord;
 use crate::results::{CaseResults, Summary, Verdict};
 use std::fmt::Write;
 
@@ -16,23 +16,99 @@ fn cell(text: &str) -> String {
     text.replace('|', "\\|").replace(['\n', '\r'], " ")
 }
 
-/// The whole `summary.md`. `records[i]` belongs to `results[i]`.
+/// The whole `summary.md`.
 pub fn summary(
     results: &[CaseResults],
-    records: &[Option<&CaseRecord>],
+    header: &Header,
+    matrix: &Matrix,
     summary: &Summary,
     comparison: Option<&Comparison>,
 ) -> String {
     let mut md = String::new();
     // Writing to a String cannot fail.
-    let _ = write_summary(&mut md, results, records, summary, comparison);
+    let _ = write_summary(&mut md, results, header, matrix, summary, comparison);
     md
+}
+
+/// A judged value: `**0.095 %** ≤ 1.00 % ✅`; unjudged: `**0.095 %** (not judged)`.
+fn judged(text: &str, j: &Judgement) -> String {
+    let mark = match j.verdict {
+        Some(Verdict::Pass) => "✅",
+        Some(Verdict::Fail) => "❌",
+        Some(Verdict::UnexpectedPass) => "❌ unexpected pass",
+        Some(Verdict::ExpectedFail) => "⚪ expected fail",
+        None => "(not judged)",
+    };
+    let bound = if j.bound.is_empty() { String::new() } else { format!(" {}", j.bound) };
+    format!("**{text}**{bound} {mark}")
+}
+
+/// A matrix cell on one line.
+fn matrix_cell(c: &Cell, metric: Option<&str>) -> String {
+    let value = match (c.value, metric) {
+        (Some(v), Some(m)) => format_metric(m, Some(v)),
+        _ => "— (no completed run)".to_string(),
+    };
+    let mut s = judged(&value, &c.value_check);
+    if c.best {
+        s.push_str(" ★");
+    }
+    s.push_str(&format!("<br>{}, dx {}", c.preset, super::numbers::format_dx(c.dx)));
+    if c.starts > 1 {
+        s.push_str(&format!(" (mean of {} starts)", c.starts));
+    }
+    s.push_str(&format!(", {:.1} s", c.wall_s));
+    if let Some(o) = c.order {
+        s.push_str(&format!("<br>order {}", judged(&format_order(Some(o)), &c.order_check)));
+    }
+    let mark = if c.tally.failed > 0 { "❌" } else { "✅" };
+    s.push_str(&format!("<br>{mark} {}", c.tally.describe()));
+    s
+}
+
+fn write_matrix(md: &mut String, m: &Matrix) -> std::fmt::Result {
+    writeln!(
+        md,
+        "## Schemes by case
+"
+    )?;
+    writeln!(
+        md,
+        "The best preset's headline error at the finest spacing with the bound of the check that \
+         judges it, its observed order, wall time, and the scheme's checks; ★ the smallest error \
+         of the case.\n"
+    )?;
+    write!(md, "| case | headline metric |")?;
+    for s in &m.schemes {
+        write!(md, " {} |", s.to_uppercase())?;
+    }
+    write!(md, "\n|---|---|")?;
+    for _ in &m.schemes {
+        write!(md, "---|")?;
+    }
+    writeln!(md)?;
+    for row in &m.rows {
+        write!(
+            md,
+            "| {} {} | `{}` |",
+            cell(&row.case),
+            if row.pass { "✅" } else { "❌" },
+            row.metric.as_deref().unwrap_or("—")
+        )?;
+        for c in &row.cells {
+            let text = c.as_ref().map_or("not run".to_string(), |c| matrix_cell(c, row.metric.as_deref()));
+            write!(md, " {} |", cell(&text))?;
+        }
+        writeln!(md)?;
+    }
+    writeln!(md)
 }
 
 fn write_summary(
     md: &mut String,
     results: &[CaseResults],
-    records: &[Option<&CaseRecord>],
+    header: &Header,
+    matrix: &Matrix,
     summary: &Summary,
     comparison: Option<&Comparison>,
 ) -> std::fmt::Result {
@@ -50,23 +126,29 @@ fn write_summary(
             String::new()
         }
     )?;
+    for (label, value) in header.lines() {
+        writeln!(md, "- {label}: {}", cell(&value))?;
+    }
+    writeln!(md)?;
+    write_matrix(md, matrix)?;
+    writeln!(md, "## Cases\n")?;
     let with_baseline = comparison.is_some();
-    write!(md, "| case | scheme | tier | dx | key errors | observed order | wall [s] | checks | result |")?;
+    write!(md, "| case | schemes | tier | dx | runs | wall [s] | checks | result |")?;
     writeln!(md, "{}", if with_baseline { " vs baseline |" } else { "" })?;
-    write!(md, "|---|---|---|---|---|---|---:|---:|---|")?;
+    write!(md, "|---|---|---|---|---:|---:|---:|---|")?;
     writeln!(md, "{}", if with_baseline { "---|" } else { "" })?;
-    for (i, r) in results.iter().enumerate() {
-        let rec = records.get(i).copied().flatten();
+    for r in results {
         let (passed, failed) = r.counts();
+        let diverged = r.runs.iter().filter(|x| !x.ok()).count();
         write!(
             md,
-            "| {} | {} | {} | {} | {} | {} | {:.1} | {} / {} | {} |",
+            "| {} | {} | {} | {} | {}{} | {:.1} | {} / {} | {} |",
             cell(&r.case),
-            cell(&r.scheme),
+            schemes(r).join(", "),
             cell(&r.tier),
             resolutions(&r.runs),
-            cell(&key_errors(r, rec)),
-            cell(&key_order(r, rec)),
+            r.runs.len(),
+            if diverged > 0 { format!(" ({diverged} diverged)") } else { String::new() },
             r.runs.iter().map(|x| x.wall_s).sum::<f64>(),
             passed,
             passed + failed,
@@ -105,8 +187,8 @@ fn write_checks(
     for r in results {
         for c in r.checks.iter().filter(|c| shown(c.verdict())) {
             any = true;
-            let value = c.value.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
-            let threshold = c.threshold.map_or("n/a".to_string(), |v| format!("{v:.4e}"));
+            let value = c.value.map_or("n/a".to_string(), |v| check_number(c, v));
+            let threshold = c.threshold.map_or("n/a".to_string(), |v| check_number(c, v));
             let note = c.note.as_deref().map(|n| format!(" — {n}")).unwrap_or_default();
             let verdict = c.verdict().label();
             let reason = c

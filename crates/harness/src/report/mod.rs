@@ -6,8 +6,11 @@
 //! `reports/<case>/index.html` with its figures `reports/<case>/*.svg` (relative links).
 //! With a baseline ([`crate::baseline`]), the pages and `summary.md` also show what moved.
 
+pub mod header;
 pub mod html;
 pub mod markdown;
+pub mod matrix;
+pub mod numbers;
 pub mod plots;
 pub mod timing;
 
@@ -20,6 +23,8 @@ use crate::error::{HarnessError, Result};
 use crate::io;
 use crate::results::{CaseResults, RunResult, Summary, case_dirs};
 use crate::snapshots::AXES;
+use header::Header;
+use matrix::Matrix;
 use std::path::{Path, PathBuf};
 
 /// A figure written next to a case page.
@@ -169,9 +174,9 @@ fn snapshot_figures(
         let mut caption = format!(
             "{title} — t = {t:.4} s, dx = {}; colour: pressure [Pa], one scale for both panels \
              (clipped to the 1st–99th percentile)",
-            html::format_dx(finest)
+            numbers::format_dx(finest)
         );
-        let mut heading = format!("{title}, dx = {}", html::format_dx(finest));
+        let mut heading = format!("{title}, dx = {}", numbers::format_dx(finest));
         if let Some((_, _, view)) = panels.iter().find(|(_, _, v)| v.cut.is_some()) {
             let [n, h, v] = [cut_axis, view.axes[0], view.axes[1]].map(|a| AXES[a]);
             heading.push_str(&format!("; cut −Δx/2 ≤ {n} − {n}_c < Δx/2"));
@@ -255,6 +260,9 @@ pub struct Rendered {
     pub comparison: Option<Comparison>,
 }
 
+/// The overview figure beside `index.html`.
+pub const OVERVIEW: &str = "overview.svg";
+
 /// Re-renders every case page, `summary.json` and `index.html` in `out` from the results
 /// files there; returns the results found.
 pub fn render_all(out: &Path) -> Result<Vec<CaseResults>> {
@@ -275,9 +283,20 @@ pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
     let summary = Summary { elapsed_s: opts.elapsed_s, ..Summary::of(&results) };
     io::write_json(&out.join("summary.json"), &summary)?;
     let records: Vec<Option<&CaseRecord>> = found.iter().map(|f| f.1.as_ref()).collect();
-    let page = html::index_page(&results, &records, &summary, comparison.as_ref(), &opts.extras);
+    let header =
+        Header::of(&results, &records, opts.elapsed_s, opts.baseline.as_ref().map(|b| b.dir.as_path()));
+    let matrix = Matrix::of(&results, &records);
+    let curves = matrix.curves(&results);
+    let overview = (!curves.is_empty()).then_some(OVERVIEW);
+    if overview.is_some() {
+        let title = "Headline error against wall time, every case and scheme";
+        let svg = plots::overview(OVERVIEW, title, &curves)?;
+        io::write_atomic(&out.join(OVERVIEW), svg.as_bytes())?;
+    }
+    let parts = html::IndexParts { header: &header, matrix: &matrix, overview, extras: &opts.extras };
+    let page = html::index_page(&results, &summary, comparison.as_ref(), &parts);
     io::write_atomic(&out.join("index.html"), page.as_bytes())?;
-    let md = markdown::summary(&results, &records, &summary, comparison.as_ref());
+    let md = markdown::summary(&results, &header, &matrix, &summary, comparison.as_ref());
     io::write_atomic(&out.join("summary.md"), md.as_bytes())?;
     Ok(Rendered { results, comparison })
 }
@@ -311,7 +330,8 @@ mod tests {
       ],
       "convergence": { "b_rel_err_max": { "order": 2.0, "preset": "paper", "dx": [0.04, 0.02], "values": [0.016, 0.004], "by_preset": { "paper": 2.0 } } },
       "checks": [
-        { "name": "b error (moments, max over history) at dx=0.02 ≤ 1%", "value": 0.004, "threshold": 0.01, "pass": true },
+        { "name": "b error (moments, max over history) at dx=0.02 ≤ 1%", "value": 0.004, "threshold": 0.01, "pass": true,
+          "judges": { "metric": "b_rel_err_max", "kind": "max", "select": { "dx": 0.02, "preset": "paper" } } },
         { "name": "tuned b error ≤ 1%", "value": null, "threshold": 0.01, "pass": false, "note": "diverged: isph-tuned_dx0.04" }
       ]
     }"#;
@@ -341,9 +361,10 @@ mod tests {
         for needle in [
             "<!DOCTYPE html>",
             "elliptical_drop",
-            "isph-paper_dx0.02",
-            "b_rel_err_max",
+            "isph-<wbr>paper_<wbr>dx0.02",
+            "b_<wbr>rel_<wbr>err_<wbr>max",
             "0.400 %",
+            "1.00 %",
             "class=\"fail\"",
             "class=\"pass\"",
             "diverged: isph-tuned_dx0.04",
@@ -381,8 +402,29 @@ mod tests {
         assert!(hist.contains("b_ref (reference)") && hist.contains("dx=0.02"));
 
         let index = std::fs::read_to_string(out.join("index.html")).unwrap();
-        for needle in ["elliptical_drop/index.html", "isph", "0.04, 0.02", "1 / 2", "FAIL", "2.00"] {
+        for needle in [
+            "elliptical_drop/index.html",
+            "isph",
+            "0.04, 0.02",
+            "1 / 2",
+            "FAIL",
+            "2.00",
+            // The header, the matrix (the judged value with its bound) and the overview.
+            "0123abc",
+            "2025-01-01T00:00:00Z",
+            "Schemes by case",
+            "<b>0.400 %</b> ≤ 1.00 % <small>pass</small>",
+            "paper, dx 0.02",
+            "src=\"overview.svg\"",
+        ] {
             assert!(index.contains(needle), "index lacks {needle:?}");
+        }
+        let overview = std::fs::read_to_string(out.join("overview.svg")).unwrap();
+        assert!(overview.contains("elliptical_drop") && overview.contains("headline error [%]"));
+        let md = std::fs::read_to_string(out.join("summary.md")).unwrap();
+        for needle in ["- commit: 0123abc", "| case | headline metric | ISPH |", "**0.400 %** ≤ 1.00 % ✅"]
+        {
+            assert!(md.contains(needle), "summary.md lacks {needle:?}:\n{md}");
         }
         let summary: crate::results::Summary = io::read_json(&out.join("summary.json")).unwrap();
         assert!(!summary.pass);
@@ -505,6 +547,6 @@ mod tests {
         let figs = render_case(dir.path(), &results, None, None).unwrap();
         assert!(figs.is_empty());
         let page = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
-        assert!(page.contains("isph-paper_dx0.04"));
+        assert!(page.contains("isph-<wbr>paper_<wbr>dx0.04"));
     }
 }

@@ -196,7 +196,7 @@ pub fn history(
                 let label = format!(
                     "{s}, {} dx={}{}{}",
                     r.preset,
-                    super::html::format_dx(r.dx),
+                    super::numbers::format_dx(r.dx),
                     start_label(r),
                     if r.ok() { "" } else { " (diverged)" }
                 );
@@ -255,7 +255,7 @@ pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[Str
             let [s, reference] = &pairs[j];
             let label = format!(
                 "{s} vs {reference}, dx={}{}{}",
-                super::html::format_dx(r.dx),
+                super::numbers::format_dx(r.dx),
                 start_label(r),
                 if r.ok() { "" } else { " (diverged)" }
             );
@@ -420,11 +420,89 @@ pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Resul
                 });
             chart
                 .draw_series(mine.iter().map(|q| {
-                    Text::new(format!("dx={}", super::html::format_dx(q.2)), (q.3, q.4), ("sans-serif", 12))
+                    Text::new(
+                        format!("dx={}", super::numbers::format_dx(q.2)),
+                        (q.3, q.4),
+                        ("sans-serif", 12),
+                    )
                 }))
                 .map_err(boxed)?;
         }
         legend(&mut chart, SeriesLabelPosition::UpperRight)?;
+        Ok(())
+    })
+    .map_err(plot_err(file))
+}
+
+/// Light variants of the palette's colours (Tableau 20's light half): the overview's
+/// cases after the first eight, since the suite has more cases than a figure has series.
+const LIGHT_COLOURS: [RGBColor; 8] = [
+    RGBColor(174, 199, 232),
+    RGBColor(255, 187, 120),
+    RGBColor(152, 223, 138),
+    RGBColor(255, 152, 150),
+    RGBColor(197, 176, 213),
+    RGBColor(196, 156, 148),
+    RGBColor(247, 182, 210),
+    RGBColor(158, 218, 229),
+];
+
+/// The overview's colour of its `i`-th case: the palette, then its light variants.
+fn case_colour(i: usize) -> RGBColor {
+    if i < COLOURS.len() { COLOURS[i] } else { LIGHT_COLOURS[(i - COLOURS.len()) % LIGHT_COLOURS.len()] }
+}
+
+/// The suite at a glance: every case's headline error \[%\] against wall time \[s\]
+/// (log-log), one colour per case, one marker per scheme (`scheme_marker!`), a line
+/// through each scheme's spacings; the legend (cases, then schemes) beside the chart.
+pub fn overview(file: &str, title: &str, curves: &[super::matrix::Curve]) -> Result<String> {
+    let mut cases: Vec<&str> = curves.iter().map(|c| c.case.as_str()).collect();
+    cases.dedup();
+    let mut schemes: Vec<&str> = curves.iter().map(|c| c.scheme.as_str()).collect();
+    schemes.sort_unstable();
+    schemes.dedup();
+    let pts = || curves.iter().flat_map(|c| c.points.iter().map(|&(w, e)| (w, 100.0 * e)));
+    let (x0, x1) = log_range(pts().map(|p| p.0), 2.0);
+    let (y0, y1) = log_range(pts().map(|p| p.1), 2.0);
+    let case_colour = |case: &str| case_colour(cases.iter().position(|c| *c == case).unwrap_or(0));
+    svg_sized((1000, 520), |root| {
+        let (plot, side) = root.split_horizontally(760);
+        let mut chart = log_log(
+            &plot,
+            title,
+            (x0, x1),
+            (y0, y1),
+            ("wall time of the run [s]", "headline error [%]"),
+            Axis::Y,
+        )?;
+        for c in curves {
+            let colour = case_colour(&c.case);
+            let line: Vec<(f64, f64)> =
+                c.points.iter().map(|&(w, e)| (w, 100.0 * e)).filter(|p| p.0 > 0.0 && p.1 > 0.0).collect();
+            chart.draw_series(LineSeries::new(line.clone(), colour.stroke_width(1))).map_err(boxed)?;
+            chart
+                .draw_series(line.iter().map(|&p| -> DynElement<SVGBackend, (f64, f64)> {
+                    scheme_marker!(c.scheme.as_str(), p, 5, colour)
+                }))
+                .map_err(boxed)?;
+        }
+        // The legend: a line per case in its colour, then a grey marker per scheme.
+        let text = ("sans-serif", 13).into_font();
+        let grey = RGBColor(90, 90, 90);
+        let mut y = 30;
+        for case in &cases {
+            let c = case_colour(case);
+            side.draw(&PathElement::new(vec![(8, y), (30, y)], c.stroke_width(3))).map_err(boxed)?;
+            side.draw(&Text::new(case.to_string(), (36, y - 7), text.clone())).map_err(boxed)?;
+            y += 20;
+        }
+        y += 10;
+        for scheme in &schemes {
+            let marker: DynElement<SVGBackend, (i32, i32)> = scheme_marker!(*scheme, (19, y), 5, grey);
+            side.draw(&marker).map_err(boxed)?;
+            side.draw(&Text::new(scheme.to_string(), (36, y - 7), text.clone())).map_err(boxed)?;
+            y += 20;
+        }
         Ok(())
     })
     .map_err(plot_err(file))

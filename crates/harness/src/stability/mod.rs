@@ -34,7 +34,7 @@ use crate::io;
 use crate::patch::merge_patch;
 use crate::progress::Progress;
 use crate::provenance::Provenance;
-use crate::report::html::format_dx;
+use crate::report::numbers::{format_dx, percent};
 use crate::results::{CheckResult, RunResult, check_counts};
 use crate::runner::{Job, Ran, Runner};
 use crate::sweep::{RunSpec, effective_scene};
@@ -81,7 +81,7 @@ impl Trial {
         if self.status != "ok" {
             Some(self.status.clone())
         } else if !self.stable {
-            Some(format!("error {:.3} % above the bound {:.3} %", 100.0 * self.error, 100.0 * bound))
+            Some(format!("error {} above the bound {}", percent(self.error), percent(bound)))
         } else {
             None
         }
@@ -757,7 +757,8 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
     io::write_atomic(&dir.join("index.html"), page::render(&results, cfg).as_bytes())?;
     // The index links the study.
     let cases = Some(crate::case::known_cases(&opts.validation_dir)?);
-    let extras = vec![results.index_entry()];
+    let extras =
+        std::iter::once(results.index_entry()).chain(crate::work_precision::extra_page(&opts.out)).collect();
     crate::report::render(
         &opts.out,
         &crate::report::RenderOptions { cases, baseline: None, extras, elapsed_s: None },
@@ -765,9 +766,9 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
     Ok(results)
 }
 
-/// A fraction in percent (`1.234 %`, `—`).
+/// A fraction in percent as the report writes it (`1.23 %`, `—`).
 pub(crate) fn pct(v: f64) -> String {
-    if v.is_finite() { format!("{:.3} %", 100.0 * v) } else { "—".into() }
+    if v.is_finite() { percent(v) } else { "—".into() }
 }
 
 /// The envelope's checks (the study file's, in order) on its `rows`; `panics` counts the
@@ -780,6 +781,7 @@ pub fn checks(specs: &[Check], rows: &[Row], panics: usize, tier: Tier) -> Vec<C
         pass,
         note: note.map(str::to_string),
         expected_failure: None,
+        judges: None,
     };
     specs
         .iter()
@@ -801,6 +803,7 @@ pub fn checks(specs: &[Check], rows: &[Row], panics: usize, tier: Tier) -> Vec<C
                     pass: false,
                     note: spec.missing.clone(),
                     expected_failure: spec.expected_failure.clone(),
+                    judges: None,
                 })
             }),
             Check::Jittered { name, preset, fraction, rows: expected, missing } => {

@@ -1,7 +1,8 @@
 //! `reports/stability/index.html`: the envelope's rows, grouped by study, self-contained.
 
 use super::{Config, Row, StabilityResults, pct};
-use crate::report::html::{ExtraPage, checks_table, format_dx, page as html_page};
+use crate::report::html::{ExtraPage, checks_table, page as html_page};
+use crate::report::numbers::format_dx;
 use maud::{Markup, html};
 
 impl StabilityResults {
@@ -120,7 +121,7 @@ pub fn render(res: &StabilityResults, config: &Config) -> String {
         }
         p class=(if failed == 0 { "pass" } else { "fail" }) { (passed) " / " (passed + failed) " checks passed" }
         h2 { "Checks" }
-        (checks_table(&res.checks, |v| format!("{v:.4}")))
+        (checks_table(&res.checks))
         h2 { "Option sets" }
         ul {
             @for set in config.option_sets.iter().filter(|o| s.option_sets.contains(&o.name)) {

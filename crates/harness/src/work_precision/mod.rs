@@ -152,7 +152,7 @@ pub fn run(opts: &Options) -> Result<Study> {
             if reused { " cached" } else { "" }
         ))
     };
-    let pct = |e: Option<f64>| e.map_or("—".into(), |e| format!("{:.3} %", 100.0 * e));
+    let pct = |e: Option<f64>| e.map_or("—".into(), crate::report::numbers::percent);
     let jobs = design
         .runs
         .iter()
@@ -369,6 +369,28 @@ pub fn figures(study: &Study) -> Result<Vec<page::Figure>> {
         });
     }
     Ok(out)
+}
+
+/// The report index's link to the study's page, when `out` (the validation's output
+/// directory) holds a finished study in `work_precision/`.
+pub fn extra_page(out: &Path) -> Option<crate::report::ExtraPage> {
+    let study: Study = io::read_json(&out.join("work_precision").join("results.json")).ok()?;
+    let missed = study.targets.iter().filter(|t| t.pass == Some(false)).count();
+    Some(crate::report::ExtraPage {
+        href: "work_precision/index.html".into(),
+        title: "Work-precision study".into(),
+        summary: format!(
+            "run time against error for every scheme and spacing: {} runs, tier {}, {:.0} s, \
+             {} / {} targets met{}",
+            study.runs.len(),
+            study.tier,
+            study.elapsed_s,
+            study.targets.iter().filter(|t| t.pass == Some(true)).count(),
+            study.targets.iter().filter(|t| t.pass.is_some()).count(),
+            if study.complete { "" } else { " (incomplete)" }
+        ),
+        pass: missed == 0 && study.complete,
+    })
 }
 
 /// Writes `results.json`, the SVGs and `index.html` into `out`, each atomically.
