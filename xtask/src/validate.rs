@@ -3,7 +3,7 @@
 
 use anyhow::Context;
 use meniscus_harness::ValidateOptions;
-use meniscus_harness::report::numbers::{check_bound, check_number};
+use meniscus_harness::numbers::{check_bound, check_number};
 use std::path::PathBuf;
 use std::process::ExitCode;
 use std::time::Instant;

@@ -29,6 +29,7 @@
 //! a check.
 
 use crate::fit::fit_power_law;
+use crate::numbers::format_metric;
 pub use crate::results::{CheckKind, Judged, Selector};
 use crate::results::{CheckResult, RunResult};
 use crate::tier::Tier;
@@ -404,7 +405,8 @@ fn spread(runs: &[&RunResult], metric: &str) -> Option<String> {
         .map(|(slug, vs)| {
             let lo = vs.iter().copied().fold(f64::INFINITY, f64::min);
             let hi = vs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-            format!("{slug} over {} starts: {lo:.4e} – {hi:.4e}", vs.len())
+            let (lo, hi) = (format_metric(metric, Some(lo)), format_metric(metric, Some(hi)));
+            format!("{slug} over {} starts: {lo} – {hi}", vs.len())
         })
         .collect();
     (!parts.is_empty()).then(|| parts.join("; "))
@@ -726,7 +728,7 @@ mod tests {
         assert!(!r.pass, "one start of three is over the bound");
         assert_eq!(r.value, Some(0.009));
         assert!(
-            r.note.as_deref().unwrap().contains("isph-paper_dx0.02 over 3 starts: 4.0000e-3 – 9.0000e-3"),
+            r.note.as_deref().unwrap().contains("isph-paper_dx0.02 over 3 starts: 0.400 % – 0.900 %"),
             "{r:?}"
         );
         let c = spec(

@@ -24,6 +24,7 @@ pub mod error;
 pub mod fit;
 pub mod io;
 pub mod metrics;
+pub mod numbers;
 pub mod patch;
 pub mod progress;
 pub mod provenance;

@@ -3,10 +3,10 @@
 use super::FigureFile;
 use super::header::Header;
 use super::matrix::{Cell, Judgement, Matrix};
-use super::numbers::{check_number, dx_list, format_dx, format_metric, format_order, significant};
 use crate::baseline::{CaseComparison, Comparison, Mark, MetricChange, Speed, WallChange};
 use crate::case::{CaseRecord, Published};
 use crate::checks::same_spacing;
+use crate::numbers::{check_number, dx_list, format_dx, format_metric, format_order, significant};
 use crate::results::{CaseResults, CheckResult, RunResult, Summary, Verdict, expected_failures};
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 

@@ -6,8 +6,8 @@
 use super::header::Header;
 use super::html::{format_change, format_ratio, resolutions, schemes};
 use super::matrix::{Cell, Judgement, Matrix};
-use super::numbers::{check_number, format_metric, format_order};
 use crate::baseline::{CaseComparison, Comparison, Mark};
+use crate::numbers::{check_number, format_metric, format_order};
 use crate::results::{CaseResults, Summary, Verdict};
 use std::fmt::Write;
 
@@ -53,7 +53,7 @@ fn matrix_cell(c: &Cell, metric: Option<&str>) -> String {
     if c.best {
         s.push_str(" ★");
     }
-    s.push_str(&format!("<br>{}, dx {}", c.preset, super::numbers::format_dx(c.dx)));
+    s.push_str(&format!("<br>{}, dx {}", c.preset, crate::numbers::format_dx(c.dx)));
     if c.starts > 1 {
         s.push_str(&format!(" (mean of {} starts)", c.starts));
     }

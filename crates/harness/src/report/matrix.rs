@@ -13,9 +13,9 @@
 //! - **Best scheme** of a case: the smallest headline value, when two or more schemes have
 //!   one.
 
-use super::numbers::{check_bound, is_relative};
 use crate::case::CaseRecord;
 use crate::checks::{CheckKind, Checked, per_spacing, same_spacing};
+use crate::numbers::{check_bound, is_relative};
 use crate::results::{CaseResults, CheckResult, RunResult, Verdict};
 
 /// Schemes in the order the matrix lists them; others follow alphabetically.

@@ -10,7 +10,6 @@ pub mod header;
 pub mod html;
 pub mod markdown;
 pub mod matrix;
-pub mod numbers;
 pub mod plots;
 pub mod timing;
 
@@ -174,9 +173,9 @@ fn snapshot_figures(
         let mut caption = format!(
             "{title} — t = {t:.4} s, dx = {}; colour: pressure [Pa], one scale for both panels \
              (clipped to the 1st–99th percentile)",
-            numbers::format_dx(finest)
+            crate::numbers::format_dx(finest)
         );
-        let mut heading = format!("{title}, dx = {}", numbers::format_dx(finest));
+        let mut heading = format!("{title}, dx = {}", crate::numbers::format_dx(finest));
         if let Some((_, _, view)) = panels.iter().find(|(_, _, v)| v.cut.is_some()) {
             let [n, h, v] = [cut_axis, view.axes[0], view.axes[1]].map(|a| AXES[a]);
             heading.push_str(&format!("; cut −Δx/2 ≤ {n} − {n}_c < Δx/2"));

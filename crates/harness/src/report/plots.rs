@@ -196,7 +196,7 @@ pub fn history(
                 let label = format!(
                     "{s}, {} dx={}{}{}",
                     r.preset,
-                    super::numbers::format_dx(r.dx),
+                    crate::numbers::format_dx(r.dx),
                     start_label(r),
                     if r.ok() { "" } else { " (diverged)" }
                 );
@@ -255,7 +255,7 @@ pub fn error_history(file: &str, title: &str, runs: &[&RunResult], pairs: &[[Str
             let [s, reference] = &pairs[j];
             let label = format!(
                 "{s} vs {reference}, dx={}{}{}",
-                super::numbers::format_dx(r.dx),
+                crate::numbers::format_dx(r.dx),
                 start_label(r),
                 if r.ok() { "" } else { " (diverged)" }
             );
@@ -421,7 +421,7 @@ pub fn cost(file: &str, title: &str, runs: &[&RunResult], metric: &str) -> Resul
             chart
                 .draw_series(mine.iter().map(|q| {
                     Text::new(
-                        format!("dx={}", super::numbers::format_dx(q.2)),
+                        format!("dx={}", crate::numbers::format_dx(q.2)),
                         (q.3, q.4),
                         ("sans-serif", 12),
                     )

@@ -1,8 +1,8 @@
 //! `reports/stability/index.html`: the envelope's rows, grouped by study, self-contained.
 
 use super::{Config, Row, StabilityResults, pct};
+use crate::numbers::format_dx;
 use crate::report::html::{ExtraPage, checks_table, page as html_page};
-use crate::report::numbers::format_dx;
 use maud::{Markup, html};
 
 impl StabilityResults {

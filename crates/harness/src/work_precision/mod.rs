@@ -152,7 +152,7 @@ pub fn run(opts: &Options) -> Result<Study> {
             if reused { " cached" } else { "" }
         ))
     };
-    let pct = |e: Option<f64>| e.map_or("—".into(), crate::report::numbers::percent);
+    let pct = |e: Option<f64>| e.map_or("—".into(), crate::numbers::percent);
     let jobs = design
         .runs
         .iter()

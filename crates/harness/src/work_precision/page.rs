@@ -24,7 +24,7 @@ pub struct Figure {
 }
 
 fn pct(v: Option<f64>) -> String {
-    v.map_or("—".into(), |x| if x.is_finite() { crate::report::numbers::percent(x) } else { "NaN".into() })
+    v.map_or("—".into(), |x| if x.is_finite() { crate::numbers::percent(x) } else { "NaN".into() })
 }
 
 fn value(v: Option<f64>, unit: &str) -> String {

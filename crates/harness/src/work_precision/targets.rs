@@ -170,7 +170,7 @@ pub fn evaluate(runs: &[RunRow], threads: usize, finest_dx: f64) -> Vec<Target> 
         B_ERR_WALL_S,
         "s",
         match best {
-            Some((r, (e, _))) => format!("{} (b error {})", r.id, crate::report::numbers::percent(e)),
+            Some((r, (e, _))) => format!("{} (b error {})", r.id, crate::numbers::percent(e)),
             None => format!("no ISPH run reached b error ≤ {} %", B_ERR * 100.0),
         },
     );

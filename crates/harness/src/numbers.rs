@@ -1,9 +1,10 @@
-//! How the report writes numbers, the same in checks, tables, the index and `summary.md`:
+//! How the harness writes numbers, the same in checks and their notes, tables, the index,
+//! `summary.md` and the console:
 //! relative errors, drifts and relative changes in percent to three significant digits;
 //! other values to four significant digits with their unit; counts as integers; observed
 //! orders to two decimals; spacings as written.
 
-use crate::checks::CheckKind;
+use crate::results::CheckKind;
 use crate::results::CheckResult;
 
 /// Significant digits of a percentage.
@@ -134,7 +135,7 @@ pub fn check_bound(check: &CheckResult) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::checks::{Judged, Selector};
+    use crate::results::{Judged, Selector};
 
     #[test]
     fn percentages_keep_three_significant_digits() {
