@@ -53,7 +53,16 @@ for (const [, href] of indexHtml.matchAll(/<a\s[^>]*href="([^"#?]+\/index\.html)
     break;
   }
 }
-if (pages.length < 2) console.error('warning: the index links no case page with results.json');
+// An index that links no case page has lost its cases: that is a failure, not a warning.
+const indexProblems = [];
+if (pages.length < 2) indexProblems.push('index.html: links no case page (<case>/index.html with results.json)');
+// What the index must show (issue #39): the scheme-by-case matrix and the overview figure.
+for (const [what, re] of [
+  ['the scheme-by-case matrix (<table class="matrix">)', /<table class="matrix">/],
+  ['the overview figure (<img src="overview.svg">)', /<img src="overview\.svg"/],
+]) {
+  if (!re.test(indexHtml)) indexProblems.push(`index.html: lacks ${what}`);
+}
 for (const p of extraPages) if (!pages.includes(p)) pages.push(p);
 // --all: every page the index links (the cases, the stability and work-precision pages).
 if (all) {
@@ -153,7 +162,7 @@ const browser = await chromium.launch({ executablePath }).catch((e) => {
   console.error(`cannot start ${executablePath}: ${e.message.split('\n')[0]}`);
   process.exit(2);
 });
-const allProblems = [];
+const allProblems = [...indexProblems];
 try {
   for (const rel of pages) {
     const { problems, stats } = await checkPage(browser, rel);

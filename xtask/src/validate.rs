@@ -69,9 +69,9 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         eprintln!("{:<24} {:>3} passed {:>3} failed {:>3} expected to fail", r.case, passed, failed, xfail);
         for c in r.checks.iter().filter(|c| !c.pass || c.expected_failure.is_some()) {
             let value = c.value.map_or("n/a".to_string(), |v| check_number(c, v));
-            let bound = check_bound(c);
+            let bound = Some(check_bound(c)).filter(|b| !b.is_empty()).map(|b| format!(" (bound {b})"));
             let note = c.note.as_deref().map(|n| format!(" [{n}]")).unwrap_or_default();
-            eprintln!("  {} {}: {value} (bound {bound}){note}", c.verdict().label(), c.name);
+            eprintln!("  {} {}: {value}{}{note}", c.verdict().label(), c.name, bound.unwrap_or_default());
         }
     }
     if let Some(cmp) = &outcome.comparison {

@@ -41,20 +41,26 @@ pub fn unit(metric: &str) -> Option<&'static str> {
 }
 
 /// `x` to `digits` significant digits: plain between 1e-3 and 1e5, else in scientific
-/// notation (`1.235e-5`).
+/// notation (`1.235e-5`); rounded first, so 9.9996 to four digits is `10.00`.
 pub fn significant(x: f64, digits: usize) -> String {
-    if !x.is_finite() {
+    if x.is_nan() {
         return "NaN".to_string();
+    }
+    if x.is_infinite() {
+        return if x > 0.0 { "inf" } else { "-inf" }.to_string();
     }
     if x == 0.0 {
         return "0".to_string();
     }
-    let exponent = x.abs().log10().floor() as i32;
+    let prec = digits.saturating_sub(1);
+    let scientific = format!("{x:.prec$e}");
+    // The exponent after rounding to `digits`.
+    let exponent: i32 = scientific.rsplit('e').next().and_then(|e| e.parse().ok()).unwrap_or(0);
     if (-3..5).contains(&exponent) {
-        let decimals = (digits as i32 - 1 - exponent).max(0) as usize;
+        let decimals = (prec as i32 - exponent).max(0) as usize;
         format!("{x:.decimals$}")
     } else {
-        format!("{x:.prec$e}", prec = digits.saturating_sub(1))
+        scientific
     }
 }
 
@@ -68,11 +74,9 @@ pub fn percent(fraction: f64) -> String {
 pub fn format_metric(name: &str, v: Option<f64>) -> String {
     match v {
         None => "—".to_string(),
-        Some(x) if !x.is_finite() => "NaN".to_string(),
+        Some(x) if x.is_nan() => "NaN".to_string(),
         Some(x) if is_relative(name) => percent(x),
-        Some(x) if is_count(name) || (x.fract() == 0.0 && x.abs() < 1e15 && unit(name).is_none()) => {
-            format!("{x:.0}")
-        }
+        Some(x) if is_count(name) && x.is_finite() => format!("{x:.0}"),
         Some(x) => match unit(name) {
             Some(u) => format!("{} {u}", significant(x, VALUE_DIGITS)),
             None => significant(x, VALUE_DIGITS),
@@ -118,7 +122,7 @@ pub fn check_number(check: &CheckResult, v: f64) -> String {
     }
 }
 
-/// A check's bound as text with its relation (`≤ 1.00 %`, `≥ 1.50`, `= 7860`, `< 1`);
+/// A check's bound as text with its relation (`≤ 1.00 %`, `≥ 1.50`, `= 7860`, `< 1.00`);
 /// empty when it has none.
 pub fn check_bound(check: &CheckResult) -> String {
     let Some(t) = check.threshold else { return String::new() };
@@ -138,6 +142,16 @@ mod tests {
     use crate::results::{Judged, Selector};
 
     #[test]
+    fn rounding_decides_the_notation() {
+        assert_eq!(significant(9.9996, 4), "10.00");
+        assert_eq!(significant(0.000_999_96, 4), "0.001000");
+        assert_eq!(significant(99_999.6, 4), "1.000e5");
+        assert_eq!(significant(-0.012_345, 3), "-0.0123");
+        assert_eq!(significant(f64::INFINITY, 3), "inf");
+        assert_eq!(percent(0.009_999_6), "1.00 %");
+    }
+
+    #[test]
     fn percentages_keep_three_significant_digits() {
         assert_eq!(percent(1.299_84), "130 %");
         assert_eq!(percent(0.028_04), "2.80 %");
@@ -155,6 +169,7 @@ mod tests {
         assert_eq!(format_metric("particles", Some(648.0)), "648");
         assert_eq!(format_metric("min_pair_over_dx_min", Some(0.41579)), "0.4158");
         assert_eq!(format_metric("beta_max", Some(1.563_6)), "1.564");
+        assert_eq!(format_metric("beta_max", Some(3.0)), "3.000");
         assert_eq!(format_metric("dp_late", Some(5.004)), "5.004 Pa");
         assert_eq!(format_metric("u_spurious_max_late", Some(4.975e-6)), "4.975e-6 m/s");
         assert_eq!(format_metric("period", Some(0.2294)), "0.2294 s");

@@ -480,15 +480,15 @@ fn verdict_mark(v: Option<Verdict>) -> (&'static str, &'static str) {
     }
 }
 
-/// A judged value: the value in its verdict's colour, the bound beside it and the verdict;
-/// an unjudged one as information.
+/// A judged value: the value in its verdict's colour, the bound beside it and the verdict
+/// (with the check's own value when it judged more runs); an unjudged one as information.
 fn judged(text: &str, j: &Judgement) -> Markup {
     let (class, label) = verdict_mark(j.verdict);
     html! {
         span class=(format!("chip {class}")) title=(label) {
             b { (text) }
             @if !j.bound.is_empty() { " " (j.bound) }
-            " " small { (label) }
+            " " small { (label) @if let Some(v) = &j.checked { " (checked: worst " (v) ")" } }
         }
     }
 }
@@ -497,7 +497,7 @@ fn judged(text: &str, j: &Judgement) -> Markup {
 fn matrix_cell(cell: &Cell, metric: Option<&str>) -> Markup {
     let value = match (cell.value, metric) {
         (Some(v), Some(m)) => format_metric(m, Some(v)),
-        _ => "— (no completed run)".to_string(),
+        _ => format!("— ({})", cell.missing),
     };
     let tally_class = if cell.tally.failed > 0 { "fail" } else { "pass" };
     html! {
@@ -614,7 +614,8 @@ pub fn index_page(
              finest spacing the scheme ran, in the colour of the checks that bound it, with the bound \
              (grey: expected to fail; white: no check judges it, information only); its observed \
              order; the run's wall time; every check that selects the scheme's runs. ★ marks the \
-             scheme with the smallest error of the case."
+             scheme with the smallest error of the case. A check over more spacings than the one \
+             shown judges its worst value, given beside its verdict."
         }
         (matrix_table(parts.matrix))
         @if let Some(f) = parts.overview {

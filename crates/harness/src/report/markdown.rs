@@ -40,14 +40,15 @@ fn judged(text: &str, j: &Judgement) -> String {
         None => "(not judged)",
     };
     let bound = if j.bound.is_empty() { String::new() } else { format!(" {}", j.bound) };
-    format!("**{text}**{bound} {mark}")
+    let checked = j.checked.as_ref().map(|v| format!(" (checked: worst {v})")).unwrap_or_default();
+    format!("**{text}**{bound} {mark}{checked}")
 }
 
 /// A matrix cell on one line.
 fn matrix_cell(c: &Cell, metric: Option<&str>) -> String {
     let value = match (c.value, metric) {
         (Some(v), Some(m)) => format_metric(m, Some(v)),
-        _ => "— (no completed run)".to_string(),
+        _ => format!("— ({})", c.missing),
     };
     let mut s = judged(&value, &c.value_check);
     if c.best {
@@ -93,7 +94,7 @@ fn write_matrix(md: &mut String, m: &Matrix) -> std::fmt::Result {
             "| {} {} | `{}` |",
             cell(&row.case),
             if row.pass { "✅" } else { "❌" },
-            row.metric.as_deref().unwrap_or("—")
+            cell(row.metric.as_deref().unwrap_or("—"))
         )?;
         for c in &row.cells {
             let text = c.as_ref().map_or("not run".to_string(), |c| matrix_cell(c, row.metric.as_deref()));
@@ -144,7 +145,7 @@ fn write_summary(
             md,
             "| {} | {} | {} | {} | {}{} | {:.1} | {} / {} | {} |",
             cell(&r.case),
-            schemes(r).join(", "),
+            cell(&schemes(r).join(", ")),
             cell(&r.tier),
             resolutions(&r.runs),
             r.runs.len(),

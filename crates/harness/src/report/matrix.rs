@@ -5,17 +5,20 @@
 //! - **Headline metric** of a case: its first key metric (`key_metrics`) that is a relative
 //!   error ([`is_relative`]), else its first key metric.
 //! - **Best preset** of a scheme: at the finest spacing any of the scheme's presets ran,
-//!   the preset with the smallest headline value there (the mean over perturbed starts, as
-//!   the checks take it, [`per_spacing`]); when none completed there, the next spacing.
+//!   the preset with the smallest headline error there (the mean over perturbed starts, as
+//!   the checks take it, [`per_spacing`]); when none completed there, the next spacing. A
+//!   headline that is not an error (a spread factor) has no best: the scheme's first
+//!   preset stands for it.
 //! - A value is shown with a verdict only where a check bounds that metric of that run
 //!   ([`crate::checks::Judged::bounds`]); the order likewise where an `order` check selects
 //!   the preset. Anything else is information.
-//! - **Best scheme** of a case: the smallest headline value, when two or more schemes have
-//!   one.
+//! - **Best scheme** of a case: the smallest headline error, when two or more schemes have
+//!   one. A check over more runs than the value's (no `dx` in its selector) judges its
+//!   worst: the cell then gives that value too.
 
 use crate::case::CaseRecord;
-use crate::checks::{CheckKind, Checked, per_spacing, same_spacing};
-use crate::numbers::{check_bound, is_relative};
+use crate::checks::{CheckKind, per_spacing, same_spacing};
+use crate::numbers::{check_bound, check_number, is_relative};
 use crate::results::{CaseResults, CheckResult, RunResult, Verdict};
 
 /// Schemes in the order the matrix lists them; others follow alphabetically.
@@ -28,6 +31,8 @@ pub struct Judgement {
     pub verdict: Option<Verdict>,
     /// The bound of that check (`≤ 1.00 %`), empty without one.
     pub bound: String,
+    /// That check's own value, when it is not the value shown (its worst over more runs).
+    pub checked: Option<String>,
 }
 
 /// Checks of a scheme in a case, by verdict.
@@ -61,9 +66,10 @@ pub struct Cell {
     pub preset: String,
     /// The spacing of the value \[m\].
     pub dx: f64,
-    /// The headline value there (mean over perturbed starts); none when every run there
-    /// diverged.
+    /// The headline value there (mean over perturbed starts); none when no run has it.
     pub value: Option<f64>,
+    /// Why there is no value (empty when there is one).
+    pub missing: &'static str,
     /// Runs at that spacing (more than one with perturbed starts).
     pub starts: usize,
     /// The checks bounding the value.
@@ -72,7 +78,7 @@ pub struct Cell {
     pub order: Option<f64>,
     /// The `order` checks of the preset.
     pub order_check: Judgement,
-    /// Wall time of the (unperturbed) run at that spacing \[s\].
+    /// Wall time of the runs at that spacing (their mean over perturbed starts) \[s\].
     pub wall_s: f64,
     /// Every check of the case that selects a run of the scheme.
     pub tally: Tally,
@@ -114,13 +120,22 @@ fn worse(a: Verdict, b: Verdict) -> Verdict {
     if rank(b) > rank(a) { b } else { a }
 }
 
-/// The judgement of the checks among `checks` that `judges` picks.
-fn judgement<'a>(checks: impl Iterator<Item = &'a CheckResult>) -> Judgement {
-    let mut out = Judgement { verdict: None, bound: String::new() };
+/// The judgement of `checks` (those that judge the value `shown`): the worst verdict, the
+/// bound of that check, and its own value when it is not `shown` (a check over several
+/// spacings or presets judges its worst).
+fn judgement<'a>(checks: impl Iterator<Item = &'a CheckResult>, shown: Option<f64>) -> Judgement {
+    let mut out = Judgement { verdict: None, bound: String::new(), checked: None };
     for c in checks {
         let v = c.verdict();
         if out.verdict.is_none_or(|w| worse(w, v) != w) {
             out.bound = check_bound(c);
+            let same = match (c.value, shown) {
+                (Some(a), Some(b)) => (a - b).abs() <= 1e-12 * a.abs().max(b.abs()),
+                (None, None) => true,
+                _ => false,
+            };
+            out.checked =
+                if same { None } else { Some(c.value.map_or("—".to_string(), |x| check_number(c, x))) };
         }
         out.verdict = Some(out.verdict.map_or(v, |w| worse(w, v)));
     }
@@ -134,12 +149,17 @@ pub fn headline(results: &CaseResults, record: Option<&CaseRecord>) -> Option<St
     keys.iter().find(|k| is_relative(k)).or(keys.first()).cloned()
 }
 
-/// Whether check `c` concerns a run among `mine` (and not only runs of other schemes):
-/// a recorded selector matching one of them; an unrecorded check (a run's completion)
-/// naming one of them, or naming no run of `all`.
-fn concerns(c: &CheckResult, mine: &[&RunResult], all: &[RunResult]) -> bool {
+/// Whether check `c` concerns `scheme`, whose runs are `mine` (and not only runs of other
+/// schemes): a recorded selector matching one of them, or matching no run of `all` (a
+/// check that selects nothing fails; it counts for every scheme its selector allows); an
+/// unrecorded check (a run's completion) naming one of them, or naming no run of `all`.
+fn concerns(c: &CheckResult, scheme: &str, mine: &[&RunResult], all: &[RunResult]) -> bool {
     match &c.judges {
-        Some(j) => mine.iter().any(|r| j.select.matches(*r)),
+        Some(j) => {
+            mine.iter().any(|r| j.select.matches(*r))
+                || (!all.iter().any(|r| j.select.matches(r))
+                    && j.select.scheme.as_deref().is_none_or(|s| s == scheme))
+        }
         None => {
             let text = format!("{} {}", c.name, c.note.as_deref().unwrap_or(""));
             let names = |r: &RunResult| text.contains(&r.slug());
@@ -151,21 +171,28 @@ fn concerns(c: &CheckResult, mine: &[&RunResult], all: &[RunResult]) -> bool {
 /// The cell of `scheme` in `results` for `metric`.
 fn cell(results: &CaseResults, scheme: &str, metric: Option<&str>) -> Option<Cell> {
     let mine: Vec<&RunResult> = results.runs.iter().filter(|r| r.scheme == scheme).collect();
-    let first = *mine.first()?;
+    let finest_run = *mine.iter().min_by(|a, b| a.dx.total_cmp(&b.dx))?;
     let mut spacings: Vec<f64> = mine.iter().map(|r| r.dx).collect();
     spacings.sort_by(f64::total_cmp);
     spacings.dedup_by(|a, b| same_spacing(*a, *b));
-    let mut presets: Vec<&str> = mine.iter().map(|r| r.preset.as_str()).collect();
-    presets.dedup();
-    presets.sort_unstable();
-    presets.dedup();
+    // Presets in the order the runs name them: the first is the scheme's primary one.
+    let mut presets: Vec<&str> = Vec::new();
+    for r in &mine {
+        if !presets.contains(&r.preset.as_str()) {
+            presets.push(&r.preset);
+        }
+    }
     let at = |preset: &str, dx: f64| -> Vec<&RunResult> {
         mine.iter().copied().filter(|r| r.preset == preset && same_spacing(r.dx, dx)).collect()
     };
+    // Errors compare, so the best preset is the smallest; another headline has no "best":
+    // the primary preset stands for the scheme.
+    let comparable = metric.is_some_and(is_relative);
+    let candidates: &[&str] = if comparable { &presets } else { &presets[..1] };
     // (preset, dx, value): the best value at the finest spacing that has one.
     let best = metric.and_then(|m| {
         spacings.iter().find_map(|&dx| {
-            presets
+            candidates
                 .iter()
                 .filter_map(|p| {
                     let members = at(p, dx);
@@ -177,39 +204,52 @@ fn cell(results: &CaseResults, scheme: &str, metric: Option<&str>) -> Option<Cel
     });
     let (preset, dx, value) = match best {
         Some((p, dx, v)) => (p, dx, Some(v)),
-        None => (first.preset.as_str(), spacings[0], None),
+        None => (finest_run.preset.as_str(), finest_run.dx, None),
     };
     let members = at(preset, dx);
-    let shown = members.iter().find(|r| r.start.is_none()).copied().unwrap_or(members[0]);
     let of_preset: Vec<&RunResult> = mine.iter().copied().filter(|r| r.preset == preset).collect();
-    let value_check = judgement(results.checks.iter().filter(|c| {
-        metric.is_some_and(|m| c.judges.as_ref().is_some_and(|j| members.iter().any(|r| j.bounds(m, r))))
-    }));
-    let order_check = judgement(results.checks.iter().filter(|c| {
-        c.judges.as_ref().is_some_and(|j| {
-            j.kind == CheckKind::Order
-                && Some(j.metric.as_str()) == metric
-                && of_preset.iter().any(|r| j.select.matches(*r))
-        })
-    }));
+    let value_check = judgement(
+        results.checks.iter().filter(|c| {
+            metric.is_some_and(|m| c.judges.as_ref().is_some_and(|j| members.iter().any(|r| j.bounds(m, r))))
+        }),
+        value,
+    );
+    let order = metric.and_then(|m| results.convergence.get(m)?.by_preset.get(preset).copied());
+    let order_check = judgement(
+        results.checks.iter().filter(|c| {
+            c.judges.as_ref().is_some_and(|j| {
+                j.kind == CheckKind::Order
+                    && Some(j.metric.as_str()) == metric
+                    && of_preset.iter().any(|r| j.select.matches(*r))
+            })
+        }),
+        order,
+    );
     let mut tally = Tally::default();
-    for c in results.checks.iter().filter(|c| concerns(c, &mine, &results.runs)) {
+    for c in results.checks.iter().filter(|c| concerns(c, scheme, &mine, &results.runs)) {
         match c.verdict() {
             Verdict::Pass => tally.passed += 1,
             Verdict::ExpectedFail => tally.expected += 1,
             Verdict::Fail | Verdict::UnexpectedPass => tally.failed += 1,
         }
     }
+    let missing = match (metric, value) {
+        (_, Some(_)) => "",
+        (None, None) => "the case names no headline metric",
+        (Some(_), None) if members.iter().any(|r| r.ok()) => "not computed",
+        (Some(_), None) => "diverged",
+    };
     Some(Cell {
         scheme: scheme.to_string(),
         preset: preset.to_string(),
         dx,
         value,
+        missing,
         starts: members.len(),
         value_check,
-        order: metric.and_then(|m| results.convergence.get(m)?.by_preset.get(preset).copied()),
+        order,
         order_check,
-        wall_s: shown.run().wall_s,
+        wall_s: members.iter().map(|r| r.wall_s).sum::<f64>() / members.len() as f64,
         tally,
         best: false,
     })
@@ -271,7 +311,9 @@ impl Matrix {
                     schemes.iter().map(|s| cell(r, s, metric.as_deref())).collect();
                 let with_value: Vec<(usize, f64)> =
                     cells.iter().enumerate().filter_map(|(k, c)| Some((k, c.as_ref()?.value?))).collect();
-                if with_value.len() > 1
+                let comparable = metric.as_deref().is_some_and(is_relative);
+                if comparable
+                    && with_value.len() > 1
                     && let Some(&(k, _)) = with_value.iter().min_by(|a, b| a.1.total_cmp(&b.1))
                     && let Some(c) = cells[k].as_mut()
                 {
@@ -361,9 +403,12 @@ mod tests {
             )]
             .into(),
             checks: vec![
-                check(CheckKind::Max, Some("paper"), Some(0.02), 0.01, true),
+                CheckResult {
+                    value: Some(0.005),
+                    ..check(CheckKind::Max, Some("paper"), Some(0.02), 0.01, true)
+                },
                 check(CheckKind::Max, Some("tuned"), Some(0.02), 0.01, false),
-                check(CheckKind::Order, Some("paper"), None, 1.5, true),
+                CheckResult { value: Some(2.0), ..check(CheckKind::Order, Some("paper"), None, 1.5, true) },
                 CheckResult {
                     expected_failure: Some("documented".into()),
                     ..check(CheckKind::Max, Some("w"), Some(0.04), 0.001, false)
@@ -383,9 +428,15 @@ mod tests {
         assert_eq!(row.metric.as_deref(), Some("b_rel_err_max"));
         let isph = row.cells[0].as_ref().unwrap();
         assert_eq!((isph.preset.as_str(), isph.dx, isph.value), ("paper", 0.02, Some(0.005)));
-        assert_eq!(isph.value_check, Judgement { verdict: Some(Verdict::Pass), bound: "≤ 1.00 %".into() });
+        assert_eq!(
+            isph.value_check,
+            Judgement { verdict: Some(Verdict::Pass), bound: "≤ 1.00 %".into(), checked: None }
+        );
         assert_eq!(isph.order, Some(2.0));
-        assert_eq!(isph.order_check.verdict, Some(Verdict::Pass));
+        assert_eq!(
+            (isph.order_check.verdict, isph.order_check.checked.as_deref()),
+            (Some(Verdict::Pass), None)
+        );
         assert_eq!(isph.tally, Tally { passed: 2, failed: 1, expected: 0 });
         assert!(!isph.best);
         let wcsph = row.cells[1].as_ref().unwrap();
@@ -406,6 +457,67 @@ mod tests {
         assert_eq!(curves[1].points, vec![(25.0, 0.008), (50.0, 0.004)]);
     }
 
+    /// A check without a spacing judges the worst run: the cell gives that value beside
+    /// the verdict. A check that selects no run fails and counts for the schemes its
+    /// selector allows.
+    #[test]
+    fn checks_over_more_runs_and_checks_of_no_run_show() {
+        let mut r = results();
+        r.checks[0] = CheckResult {
+            value: Some(0.02),
+            pass: false,
+            ..check(CheckKind::Max, Some("paper"), None, 0.01, false)
+        };
+        r.checks.push(CheckResult {
+            value: None,
+            judges: Some(Judged {
+                metric: "b_rel_err_max".into(),
+                kind: CheckKind::Max,
+                select: Selector {
+                    preset: Some("gone".into()),
+                    scheme: Some("wcsph".into()),
+                    ..Default::default()
+                },
+            }),
+            ..check(CheckKind::Max, None, None, 0.01, false)
+        });
+        let m = Matrix::of(&[r], &[None]);
+        let isph = m.rows[0].cells[0].as_ref().unwrap();
+        assert_eq!(isph.value, Some(0.005));
+        assert_eq!(isph.value_check.verdict, Some(Verdict::Fail));
+        assert_eq!(isph.value_check.checked.as_deref(), Some("2.00 %"));
+        assert_eq!(isph.tally, Tally { passed: 1, failed: 2, expected: 0 });
+        let wcsph = m.rows[0].cells[1].as_ref().unwrap();
+        assert_eq!(wcsph.tally, Tally { passed: 0, failed: 1, expected: 1 });
+    }
+
+    /// A headline that is not an error: the scheme's first preset, no star; a scheme whose
+    /// runs all diverged (presets at different spacings): its finest run, no value.
+    #[test]
+    fn absolute_headlines_and_diverged_schemes() {
+        let mut r = results();
+        for run in &mut r.runs {
+            let v = run.metrics.remove("b_rel_err_max").unwrap();
+            run.metrics.insert("beta_max".into(), v);
+        }
+        r.runs.push(run("wcsph", "fine", 0.01, 0.0, "diverged: x"));
+        r.runs[4].status = "diverged: x".into();
+        r.runs[5].status = "diverged: x".into();
+        r.convergence.clear();
+        let record = |keys: Vec<String>| {
+            let mut case = crate::case::testing::committed("elliptical_drop");
+            case.key_metrics = keys;
+            CaseRecord { case, provenance: Default::default(), scene_hashes: Default::default() }
+        };
+        let rec = record(vec!["beta_max".into()]);
+        let m = Matrix::of(std::slice::from_ref(&r), &[Some(&rec)]);
+        let isph = m.rows[0].cells[0].as_ref().unwrap();
+        assert_eq!((isph.preset.as_str(), isph.value, isph.best), ("paper", Some(0.005), false));
+        let wcsph = m.rows[0].cells[1].as_ref().unwrap();
+        assert_eq!((wcsph.preset.as_str(), wcsph.dx, wcsph.value), ("fine", 0.01, None));
+        assert_eq!(wcsph.missing, "diverged");
+    }
+
     /// Every run of a scheme at its finest spacing diverged: the next spacing's value.
     #[test]
     fn a_diverged_finest_spacing_falls_back_to_the_next() {
@@ -414,5 +526,6 @@ mod tests {
         let m = Matrix::of(&[r], &[None]);
         let isph = m.rows[0].cells[0].as_ref().unwrap();
         assert_eq!((isph.preset.as_str(), isph.dx, isph.value), ("tuned", 0.04, Some(0.01)));
+        assert_eq!(isph.missing, "");
     }
 }

@@ -291,6 +291,9 @@ pub fn render(out: &Path, opts: &RenderOptions) -> Result<Rendered> {
         let title = "Headline error against wall time, every case and scheme";
         let svg = plots::overview(OVERVIEW, title, &curves)?;
         io::write_atomic(&out.join(OVERVIEW), svg.as_bytes())?;
+    } else {
+        // No stale figure beside an index that does not show it.
+        let _ = std::fs::remove_file(out.join(OVERVIEW));
     }
     let parts = html::IndexParts { header: &header, matrix: &matrix, overview, extras: &opts.extras };
     let page = html::index_page(&results, &summary, comparison.as_ref(), &parts);
