@@ -21,7 +21,7 @@ figcaption{font-size:90%;color:#555}code{font-size:90%}\
 .xfail{background:#ececec;color:#444}.info{background:#fff;color:#333;border:1px dashed #aaa}\
 .chip{display:inline-block;padding:1px 6px;border-radius:3px;margin:1px 0}\
 .best{color:#7a5a00;font-weight:bold}td.cell{vertical-align:top;min-width:12em}\
-table.header th{width:8em}small{font-size:80%}";
+table.header th{width:8em}small{font-size:80%}td:not(.l){white-space:nowrap}";
 
 /// The change of a metric as text: `+12.3 %` of the baseline, or `—` when undefined.
 pub fn format_change(m: &MetricChange) -> String {
