@@ -3,15 +3,16 @@
 use super::channel::{ChannelRow, ChannelStudy};
 use super::pipe::{PipeRow, PipeStudy};
 use super::record::{Cost, RunRow, SchemeCost, Study};
+use crate::report::html::breakable;
 use crate::results::FLOOR_CORE_US_PER_PARTICLE_PASS;
 use maud::{DOCTYPE, Markup, PreEscaped, html};
 
 const CSS: &str = "body{font-family:system-ui,sans-serif;margin:2em;max-width:1250px;color:#222}\
-table{border-collapse:collapse;margin:1em 0}th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}\
+table{border-collapse:collapse;margin:1em 0;max-width:100%}th,td{border:1px solid #ccc;padding:3px 8px;text-align:right}\
 th{background:#f0f0f0}td.l,th.l{text-align:left}.pass{background:#d9f2d9;color:#145214}\
 .fail{background:#f8d7d7;color:#7a1010}.na{background:#eee;color:#555}tr.front td{font-weight:bold}\
 figure{display:inline-block;margin:0.5em;vertical-align:top}figcaption{font-size:90%;color:#555;max-width:820px}\
-code{font-size:90%}.small{font-size:85%}";
+code{font-size:90%}.small{font-size:85%}table.small td,table.small th{padding:2px 4px}";
 
 /// A figure: file name (without `.svg`), SVG text and caption.
 pub struct Figure {
@@ -31,29 +32,45 @@ fn value(v: Option<f64>, unit: &str) -> String {
     v.map_or("—".into(), |x| if unit.is_empty() { format!("{x:.3}") } else { format!("{x:.3} {unit}") })
 }
 
-fn run_row(r: &RunRow, front: bool) -> Markup {
+/// Which half of a wide table a row function renders: the run's options, or what it
+/// measured (each beginning with the run's id), so no table is wider than the page.
+#[derive(Clone, Copy, PartialEq)]
+enum Half {
+    Options,
+    Measured,
+}
+
+/// The id cell that begins both halves of a row.
+fn id_cell(id: &str, reused: bool) -> Markup {
+    html! { td class="l" { code { (breakable(id)) } @if reused { " (cached)" } } }
+}
+
+fn run_row(r: &RunRow, front: bool, half: Half) -> Markup {
     let ms = r.cost.per_step().map_or("—".into(), |s| format!("{:.2}", 1e3 * s));
     html! {
         tr class=(if front { "front" } else { "" }) {
-            td class="l" { code { (r.id) } @if r.reused { " (cached)" } }
-            td { (r.dx) }
-            td class="l" { (r.scheme) }
-            @match r.variant {
-                Some(v) => {
-                    td class="l" { (snake(v.ppe)) }
-                    td class="l" { (format!("{:?}", v.gradient).to_lowercase()) }
-                    td class="l" { (format!("{:?}", v.divergence).to_lowercase()) }
-                    td class="l" { (format!("{:?}", v.shifting).to_lowercase()) }
-                    td class="l" { (format!("{:?}", v.dt).to_lowercase()) }
+            (id_cell(&r.id, r.reused))
+            @if half == Half::Options {
+                td { (r.dx) }
+                td class="l" { (r.scheme) }
+                @match r.variant {
+                    Some(v) => {
+                        td class="l" { (snake(v.ppe)) }
+                        td class="l" { (format!("{:?}", v.gradient).to_lowercase()) }
+                        td class="l" { (format!("{:?}", v.divergence).to_lowercase()) }
+                        td class="l" { (format!("{:?}", v.shifting).to_lowercase()) }
+                        td class="l" { (format!("{:?}", v.dt).to_lowercase()) }
+                    }
+                    None => { td class="l" colspan="5" { "the case preset's own options" } }
                 }
-                None => { td class="l" colspan="5" { "the case preset's own options" } }
+                td class="l" { (r.preset.as_deref().unwrap_or("")) }
+            } @else {
+                (cost_cells(r.threads, &r.cost, &ms))
+                td { (pct(r.b_err)) }
+                td { (pct(r.b_err_max)) }
+                td { (pct(r.a_err)) }
+                (status_cell(r.ok(), &r.status, r.expected_divergence.as_deref()))
             }
-            td class="l" { (r.preset.as_deref().unwrap_or("")) }
-            (cost_cells(r.threads, &r.cost, &ms))
-            td { (pct(r.b_err)) }
-            td { (pct(r.b_err_max)) }
-            td { (pct(r.a_err)) }
-            (status_cell(r.ok(), &r.status, r.expected_divergence.as_deref()))
         }
     }
 }
@@ -93,7 +110,7 @@ fn snake<T: serde::Serialize>(v: T) -> String {
     serde_json::to_value(v).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()
 }
 
-fn channel_row(r: &ChannelRow, front: bool) -> Markup {
+fn channel_row(r: &ChannelRow, front: bool, half: Half) -> Markup {
     let ms = if r.cost.steps > 0 {
         format!("{:.3}", 1e3 * r.cost.wall_s / r.cost.steps as f64)
     } else {
@@ -101,22 +118,25 @@ fn channel_row(r: &ChannelRow, front: bool) -> Markup {
     };
     html! {
         tr class=(if front { "front" } else { "" }) {
-            td class="l" { code { (r.id) } @if r.reused { " (cached)" } }
-            td { (format!("{:.5}", r.dx)) }
-            td class="l" { (r.scheme) }
-            @match r.variant {
-                Some(v) => {
-                    td class="l" { (snake(v.viscosity)) }
-                    td class="l" { (snake(v.shifting)) }
-                    td class="l" { (snake(v.ppe)) }
+            (id_cell(&r.id, r.reused))
+            @if half == Half::Options {
+                td { (format!("{:.5}", r.dx)) }
+                td class="l" { (r.scheme) }
+                @match r.variant {
+                    Some(v) => {
+                        td class="l" { (snake(v.viscosity)) }
+                        td class="l" { (snake(v.shifting)) }
+                        td class="l" { (snake(v.ppe)) }
+                    }
+                    None => { td class="l" colspan="3" { "the preset's scheme options" } }
                 }
-                None => { td class="l" colspan="3" { "the preset's scheme options" } }
+                td class="l" { (r.series().unwrap_or_default()) }
+            } @else {
+                (cost_cells(r.threads, &r.cost, &ms))
+                td { (pct(r.error)) }
+                td { (pct(r.error_startup_max)) }
+                td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
             }
-            td class="l" { (r.series().unwrap_or_default()) }
-            (cost_cells(r.threads, &r.cost, &ms))
-            td { (pct(r.error)) }
-            td { (pct(r.error_startup_max)) }
-            td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
         }
     }
 }
@@ -132,15 +152,21 @@ fn channel_section(c: &ChannelStudy) -> Markup {
         table class="small" {
             tr {
                 th class="l" { "run" } th { "Δx" } th class="l" { "scheme" } th class="l" { "viscosity" } th class="l" { "shifting" } th class="l" { "PPE" }
-                th class="l" { "preset" } th { "threads" } th { "particles" } th { "steps" } th { "wall [s]" } th { "CPU/wall" }
+                th class="l" { "preset" }
+            }
+            @for r in &c.runs { (channel_row(r, c.pareto.contains(&r.id), Half::Options)) }
+        }
+        table class="small" {
+            tr {
+                th class="l" { "run" } th { "threads" } th { "particles" } th { "steps" } th { "wall [s]" } th { "CPU/wall" }
                 th { "ms/step" } th { "PPE its" } th { "core-µs per particle-step" } th { "× floor" } th { "profile error (τ = 1)" } th { "start-up max" } th class="l" { "status" }
             }
-            @for r in &c.runs { (channel_row(r, c.pareto.contains(&r.id))) }
+            @for r in &c.runs { (channel_row(r, c.pareto.contains(&r.id), Half::Measured)) }
         }
     }
 }
 
-fn pipe_row(r: &PipeRow) -> Markup {
+fn pipe_row(r: &PipeRow, half: Half) -> Markup {
     let opt = |v: Option<f64>, digits: usize| v.map_or("—".into(), |x| format!("{x:.digits$}"));
     let particles = match r.wall_particles {
         Some(w) => format!("{} + {w}", r.cost.particles),
@@ -148,22 +174,25 @@ fn pipe_row(r: &PipeRow) -> Markup {
     };
     html! {
         tr {
-            td class="l" { code { (r.id) } @if r.reused { " (cached)" } }
-            td class="l" { (r.scheme) }
-            td class="l" { (r.preset) }
-            td { (r.r_over_dx) }
-            td { (r.threads) }
-            td { (particles) }
-            td { (r.cost.steps) }
-            td { (format!("{:.2}", r.cost.wall_s)) }
-            td { (opt(r.cost.cpu_s, 2)) }
-            td { (r.particle_steps_per_s.map_or("—".into(), |v| format!("{v:.3e}"))) }
-            td { (opt(r.memory_peak_bytes.map(|b| b as f64 / 1e6), 1)) }
-            td { (opt(r.memory_rss_before_bytes.map(|b| b as f64 / 1e6), 1)) }
-            td { (opt(r.bytes_per_particle, 0)) }
-            td { (pct(r.error)) }
-            td { (pct(r.error_startup_max)) }
-            td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
+            (id_cell(&r.id, r.reused))
+            @if half == Half::Options {
+                td class="l" { (r.scheme) }
+                td class="l" { (r.preset) }
+                td { (r.r_over_dx) }
+                td { (r.threads) }
+                td { (particles) }
+                td { (r.cost.steps) }
+            } @else {
+                td { (format!("{:.2}", r.cost.wall_s)) }
+                td { (opt(r.cost.cpu_s, 2)) }
+                td { (r.particle_steps_per_s.map_or("—".into(), |v| format!("{v:.3e}"))) }
+                td { (opt(r.memory_peak_bytes.map(|b| b as f64 / 1e6), 1)) }
+                td { (opt(r.memory_rss_before_bytes.map(|b| b as f64 / 1e6), 1)) }
+                td { (opt(r.bytes_per_particle, 0)) }
+                td { (pct(r.error)) }
+                td { (pct(r.error_startup_max)) }
+                td class=(if r.ok() { "l" } else { "l fail" }) { (r.status) }
+            }
         }
     }
 }
@@ -181,10 +210,16 @@ fn pipe_section(p: &PipeStudy) -> Markup {
         table class="small" {
             tr {
                 th class="l" { "run" } th class="l" { "scheme" } th class="l" { "preset" } th { "R/Δx" } th { "threads" } th { "particles (fluid + wall)" }
-                th { "steps" } th { "wall [s]" } th { "CPU [s]" } th { "particle-steps/s" } th { "peak [MB]" } th { "resident before [MB]" } th { "bytes/particle" }
+                th { "steps" }
+            }
+            @for r in &p.runs { (pipe_row(r, Half::Options)) }
+        }
+        table class="small" {
+            tr {
+                th class="l" { "run" } th { "wall [s]" } th { "CPU [s]" } th { "particle-steps/s" } th { "peak [MB]" } th { "resident before [MB]" } th { "bytes/particle" }
                 th { "profile error (ν t/R² = 1)" } th { "start-up max" } th class="l" { "status" }
             }
-            @for r in &p.runs { (pipe_row(r)) }
+            @for r in &p.runs { (pipe_row(r, Half::Measured)) }
         }
     }
 }
@@ -298,7 +333,7 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                 table {
                     tr { th class="l" { "scheme" } th class="l" { "run" } th { "wall [s]" } th { "b error" } th { "a error" } }
                     @for r in &front {
-                        tr { td class="l" { (r.scheme) } td class="l" { code { (r.id) } } td { (format!("{:.3}", r.cost.wall_s)) } td { (pct(r.b_err)) } td { (pct(r.a_err)) } }
+                        tr { td class="l" { (r.scheme) } td class="l" { code { (breakable(&r.id)) } } td { (format!("{:.3}", r.cost.wall_s)) } td { (pct(r.b_err)) } td { (pct(r.a_err)) } }
                     }
                 }
                 h2 { "Cost per step and threads" }
@@ -352,10 +387,16 @@ pub fn render(study: &Study, figures: &[Figure]) -> String {
                 table class="small" {
                     tr {
                         th class="l" { "run" } th { "Δx" } th class="l" { "scheme" } th class="l" { "PPE" } th class="l" { "gradient" } th class="l" { "divergence" }
-                        th class="l" { "shifting" } th class="l" { "Δt" } th class="l" { "preset" } th { "threads" } th { "particles" }
+                        th class="l" { "shifting" } th class="l" { "Δt" } th class="l" { "preset" }
+                    }
+                    @for r in &study.runs { (run_row(r, study.pareto.contains(&r.id), Half::Options)) }
+                }
+                table class="small" {
+                    tr {
+                        th class="l" { "run" } th { "threads" } th { "particles" }
                         th { "steps" } th { "wall [s]" } th { "CPU/wall" } th { "ms/step" } th { "PPE its" } th { "core-µs per particle-step" } th { "× floor" } th { "b error (t = 0.008)" } th { "b error (max)" } th { "a error (t = 0.008)" } th class="l" { "status" }
                     }
-                    @for r in &study.runs { (run_row(r, study.pareto.contains(&r.id))) }
+                    @for r in &study.runs { (run_row(r, study.pareto.contains(&r.id), Half::Measured)) }
                 }
             }
         }
