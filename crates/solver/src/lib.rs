@@ -22,6 +22,7 @@ pub mod linalg;
 pub mod mps;
 pub mod neighbours;
 pub mod operators;
+pub mod otm;
 pub mod ppe;
 pub mod probes;
 pub mod profile;
