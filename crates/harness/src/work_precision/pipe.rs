@@ -553,7 +553,10 @@ mod tests {
         super::super::write(dir.path(), &study).unwrap();
         let html = std::fs::read_to_string(dir.path().join("index.html")).unwrap();
         assert!(html.contains("<h2>3D pipe</h2>") && html.contains("bytes/particle"), "the pipe's section");
-        assert!(html.contains("pipe_<wbr>dx0.00250_<wbr>t1_<wbr>wcsph_<wbr>xu") && html.contains("particle-steps/s"));
+        assert!(
+            html.contains("pipe_<wbr>dx0.00250_<wbr>t1_<wbr>wcsph_<wbr>xu")
+                && html.contains("particle-steps/s")
+        );
         let svg = std::fs::read_to_string(dir.path().join("pipe_work_precision.svg")).unwrap();
         assert!(svg.starts_with("<svg") && svg.trim_end().ends_with("</svg>"));
         assert!(svg.contains("qiu R/4") && svg.contains("wcsph_xu R/4"), "both points labelled");
