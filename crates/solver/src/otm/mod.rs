@@ -2,13 +2,15 @@
 //! 2021, seed 003; OTM.md): nodes carrying position and velocity, material points carrying
 //! mass, volume and stress, coupled by local max-entropy shape functions ([`lme`]); the
 //! bodies triangulated once at set-up ([`mesh`]); surface tension as the energy of the
-//! boundary nodes' polyline ([`surface`]).
+//! boundary nodes' polyline ([`surface`]); the step of a 2D body ([`step`]).
 //!
-//! Issue #38 in progress: these are the method's building blocks, each tested on its own;
-//! the OTM step and its scheme come next (docs/notes/otm.md).
+//! Issue #38 in progress: the step runs a body on its own (Zhou's static drop settles at
+//! γ/R to 0.13 % at R/h = 20); the scheme that runs it from a scene comes next
+//! (docs/notes/otm.md).
 
 pub mod lme;
 pub mod mesh;
+pub mod step;
 pub mod surface;
 
 #[cfg(test)]
