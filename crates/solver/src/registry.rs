@@ -5,6 +5,7 @@ use crate::error::SceneError;
 use crate::isph::Isph;
 use crate::kernel::{CubicSpline, Kernel, Scaled, WendlandC2};
 use crate::mps::Mps;
+use crate::otm::scheme::Otm;
 use crate::probes::Weight;
 use crate::scene::{KernelKind, Scene, Scheme as SceneScheme};
 use crate::scheme::{Method, Scheme};
@@ -28,6 +29,7 @@ pub fn compose<const D: usize>(scene: &Scene) -> Result<Built<D>, SceneError> {
         SceneScheme::Isph(_) => compose_with::<D, Isph>(scene),
         SceneScheme::Wcsph(_) => compose_with::<D, Wcsph>(scene),
         SceneScheme::Mps(_) => compose_with::<D, Mps>(scene),
+        SceneScheme::Otm(_) => compose_with::<D, Otm>(scene),
     }
 }
 

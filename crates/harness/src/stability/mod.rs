@@ -914,7 +914,7 @@ mod tests {
                         )
                     }
                     // MPS option sets differ in their own options, not in shifting.
-                    (meniscus::scene::Scheme::Mps(_), _) => {}
+                    (meniscus::scene::Scheme::Mps(_) | meniscus::scene::Scheme::Otm(_), _) => {}
                 }
             }
         }

@@ -4,12 +4,12 @@
 //! bodies triangulated once at set-up ([`mesh`]); surface tension as the energy of the
 //! boundary nodes' polyline ([`surface`]); the step of a 2D body ([`step`]).
 //!
-//! Issue #38 in progress: the step runs a body on its own (Zhou's static drop settles at
-//! γ/R to 0.13 % at R/h = 20); the scheme that runs it from a scene comes next
-//! (docs/notes/otm.md).
+//! As a scheme of the scene file ([`scheme`]): 2D, one free body so far (issue #38 in
+//! progress; docs/notes/otm.md).
 
 pub mod lme;
 pub mod mesh;
+pub mod scheme;
 pub mod step;
 pub mod surface;
 

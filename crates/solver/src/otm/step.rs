@@ -123,6 +123,14 @@ impl Body {
         }
     }
 
+    /// The material points' velocities \[m/s\]: `Σ_a N_a(x_p) v_a` with the shape functions
+    /// of the last step (those that moved the points), the nodes' velocities now.
+    pub fn point_velocities(&self) -> impl Iterator<Item = Point> + '_ {
+        (0..self.points.len()).map(|p| {
+            (self.offsets[p]..self.offsets[p + 1]).map(|k| self.velocity[self.support[k]] * self.n[k]).sum()
+        })
+    }
+
     /// The support radius \[m\] of the shape functions.
     fn radius(&self) -> f64 {
         self.params.lme.cutoff(self.h, self.params.support_tolerance)

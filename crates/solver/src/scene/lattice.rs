@@ -177,17 +177,26 @@ fn cylinder_points<const D: usize>(
     out
 }
 
-/// Seeds (position, velocity, pressure) of one body; `g` is the body force for hydrostatic
-/// pressure, `density` the fluid density \[kg/m³\].
-pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector<f64, D>) -> Vec<Seed<D>> {
-    let velocity = |x: &SVector<f64, D>| match &body.velocity {
+/// The initial velocity of `body` at `x` \[m/s\].
+pub fn initial_velocity<const D: usize>(body: &Body, x: &SVector<f64, D>) -> SVector<f64, D> {
+    match &body.velocity {
         InitialVelocity::Zero => SVector::<f64, D>::zeros(),
         InitialVelocity::Affine { gradient, offset } => {
             let m = SMatrix::<f64, D, D>::from_fn(|i, j| gradient[i][j]);
             m * x + SVector::<f64, D>::from_iterator(offset.iter().copied())
         }
-    };
-    let pressure = |x: &SVector<f64, D>| match &body.pressure {
+    }
+}
+
+/// The initial pressure of `body` at `x` \[Pa\] (`density` \[kg/m³\] and the body force `g`
+/// \[m/s²\] for a hydrostatic field).
+pub fn initial_pressure<const D: usize>(
+    body: &Body,
+    x: &SVector<f64, D>,
+    density: f64,
+    g: &SVector<f64, D>,
+) -> f64 {
+    match &body.pressure {
         InitialPressure::Zero => 0.0,
         InitialPressure::Quadratic { center, value, hessian } => {
             let c = SVector::<f64, D>::from_iterator(center.iter().copied());
@@ -199,7 +208,14 @@ pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector
             let s = SVector::<f64, D>::from_iterator(surface_point.iter().copied());
             density * g.dot(&(x - s))
         }
-    };
+    }
+}
+
+/// Seeds (position, velocity, pressure) of one body; `g` is the body force for hydrostatic
+/// pressure, `density` the fluid density \[kg/m³\].
+pub fn seed_body<const D: usize>(body: &Body, dx: f64, density: f64, g: &SVector<f64, D>) -> Vec<Seed<D>> {
+    let velocity = |x: &SVector<f64, D>| initial_velocity(body, x);
+    let pressure = |x: &SVector<f64, D>| initial_pressure(body, x, density, g);
     seed_points::<D>(body, dx).into_iter().map(|x| Seed { x, u: velocity(&x), p: pressure(&x) }).collect()
 }
 

@@ -388,6 +388,27 @@ pub enum Scheme {
     /// with the mixed source of Lee et al. 2011; MPS.md): number-density weights instead of
     /// a kernel, a pressure Poisson equation per step, multi-layer wall particles.
     Mps(MpsOptions),
+    /// Optimal-transportation meshfree method (Li, Habbal & Ortiz 2010; Zhou et al. 2021;
+    /// OTM.md): the body triangulated at set-up, nodes and material points coupled by local
+    /// max-entropy shape functions, surface tension as the boundary's energy ([`crate::otm`]).
+    Otm(OtmOptions),
+}
+
+/// Options of the optimal-transportation meshfree scheme (see [`crate::otm`]): 2D, one
+/// fluid body (a circle or a rectangle) meshed at the scene's `dx`; the scene's `kernel`
+/// is used only by the probes' kernel-weighted averages.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct OtmOptions {
+    /// Sound speed c₀ of the equation of state `p = c₀² (ρ − ρ₀)` \[m/s\].
+    pub sound_speed: f64,
+    /// Locality γ of the LME shape functions, `β = γ / dx²` (dimensionless; 1.5 if absent).
+    #[serde(default = "default_locality")]
+    pub locality: f64,
+}
+
+fn default_locality() -> f64 {
+    1.5
 }
 
 impl Scheme {
@@ -397,6 +418,7 @@ impl Scheme {
             Scheme::Isph(_) => "isph",
             Scheme::Wcsph(_) => "wcsph",
             Scheme::Mps(_) => "mps",
+            Scheme::Otm(_) => "otm",
         }
     }
 }

@@ -112,6 +112,7 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         Scheme::Isph(o) => validate_isph(o, d)?,
         Scheme::Wcsph(o) => validate_wcsph(o)?,
         Scheme::Mps(o) => validate_mps(o, scene)?,
+        Scheme::Otm(o) => validate_otm(o, scene)?,
     }
     validate_young_laplace(scene)?;
     positive("time.end", scene.time.end)?;
@@ -314,6 +315,57 @@ fn validate_ppe(field: &str, ppe: &PpeOptions) -> Result<(), SceneError> {
 }
 
 /// The rules of the MPS options (MPS.md) and of what the MPS step does not have.
+/// The OTM scheme runs one 2D fluid body (a circle or a rectangle, meshed at `dx`)
+/// without walls, periodic or open boundaries (not built yet: issue #38).
+fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
+    positive("scheme.otm.sound_speed", o.sound_speed)?;
+    if !(o.locality.is_finite() && o.locality > 0.0) {
+        return Err(SceneError::new(
+            "scheme.otm.locality",
+            o.locality,
+            "must be a positive number (the LME locality γ, β = γ / dx²; 0.8 to 4 is usual, 1.5 the default)",
+        ));
+    }
+    if scene.dimension != 2 {
+        return Err(SceneError::new("dimension", scene.dimension, "the otm scheme runs 2D scenes"));
+    }
+    let not_yet = |field: &str, value: &str| {
+        Err(SceneError::new(
+            field,
+            value,
+            "is not supported by the otm scheme yet (one free body, issue #38)",
+        ))
+    };
+    if scene.has_walls() {
+        return not_yet("boundaries.walls", "walls");
+    }
+    if !scene.boundaries.periodic.is_empty() {
+        return not_yet("boundaries.periodic", "periodic axes");
+    }
+    if scene.boundaries.inflow.is_some() || scene.boundaries.outflow.is_some() {
+        return not_yet("boundaries.inflow", "open boundaries");
+    }
+    if scene.bodies.len() != 1 {
+        return Err(SceneError::new(
+            "bodies",
+            format!("{} bodies", scene.bodies.len()),
+            "the otm scheme meshes exactly one fluid body",
+        ));
+    }
+    let body = &scene.bodies[0];
+    if !matches!(body.shape, Shape::Circle { .. } | Shape::Rectangle { .. }) {
+        return Err(SceneError::new(
+            "bodies[0].shape",
+            "not a circle or rectangle",
+            "the otm scheme's mesher triangulates a circle or a rectangle",
+        ));
+    }
+    if body.jitter.is_some() {
+        return not_yet("bodies[0].jitter", "a jittered lattice");
+    }
+    Ok(())
+}
+
 fn validate_mps(o: &MpsOptions, scene: &Scene) -> Result<(), SceneError> {
     validate_ppe("scheme.mps.ppe", &o.ppe)?;
     let r = o.radii();
@@ -663,7 +715,7 @@ fn validate_young_laplace(scene: &Scene) -> Result<(), SceneError> {
         Scheme::Isph(_) => {
             Err(SceneError::new("fluid.surface_tension_model", "young_laplace", NOT_SYMMETRIC))
         }
-        Scheme::Wcsph(_) | Scheme::Mps(_) => Err(SceneError::new(
+        Scheme::Wcsph(_) | Scheme::Mps(_) | Scheme::Otm(_) => Err(SceneError::new(
             "fluid.surface_tension_model",
             "young_laplace",
             "is for the projection scheme (isph) only: it sets the free-surface Dirichlet pressure",
