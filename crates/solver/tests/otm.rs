@@ -47,7 +47,7 @@ fn bad_otm_input_names_the_field() {
     let mut v = static_drop(0.02, 0.3);
     v["scheme"]["otm"]["locality"] = json!(0.0);
     let e = error_of(v).to_string();
-    assert!(e.contains("scheme.otm.locality") && e.contains("positive"), "{e}");
+    assert!(e.contains("scheme.otm.locality") && e.contains("(0, 10]"), "{e}");
     let mut v = static_drop(0.02, 0.3);
     v["scheme"]["otm"]["sound_speed"] = json!(-1.0);
     assert!(error_of(v).to_string().contains("scheme.otm.sound_speed"));
@@ -60,7 +60,7 @@ fn bad_otm_input_names_the_field() {
     v["scheme"] = json!({"wcsph": {"sound_speed": 50.0, "locality": 1.5}});
     let e = error_of(v).to_string();
     assert!(e.contains("locality"), "{e}");
-    // What the scheme does not run yet: walls, a 3D scene, two bodies, a sphere.
+    // What the scheme does not run yet: walls, two bodies; nor a locality beyond 10.
     let mut v = static_drop(0.02, 0.3);
     v["boundaries"] = json!({"walls": [{"axis": 1, "position": -0.3, "fluid_side": "above"}]});
     let e = error_of(v).to_string();
@@ -69,6 +69,16 @@ fn bad_otm_input_names_the_field() {
     let body = v["bodies"][0].clone();
     v["bodies"] = json!([body.clone(), body]);
     assert!(error_of(v).to_string().contains("exactly one fluid body"));
+    let mut v = static_drop(0.02, 0.3);
+    v["scheme"]["otm"]["locality"] = json!(12.0);
+    assert!(error_of(v).to_string().contains("(0, 10]"));
+    // An initial pressure that the equation of state turns into a negative density.
+    let mut v = static_drop(0.02, 0.3);
+    v["bodies"][0]["pressure"] =
+        json!({"quadratic": {"center": [0.0, 0.0], "value": -3000.0, "hessian": [[0.0, 0.0], [0.0, 0.0]]}});
+    let scene = Scene::from_json(&v.to_string()).expect("valid scene file");
+    let e = meniscus::run(&scene, &mut Quiet).expect_err("a negative density").to_string();
+    assert!(e.contains("bodies[0].pressure") && e.contains("non-positive density"), "{e}");
 }
 
 /// A step far beyond the stable one folds the nodal map: the run stops with the OTM's

@@ -72,6 +72,12 @@ pub enum LmeError {
         /// `|r| / h` when it stopped.
         residual: f64,
     },
+    /// The point or its nodes are not finite.
+    #[error("point {point:?} m: the shape functions are not finite (a non-finite position)")]
+    NotFinite {
+        /// The point \[m\].
+        point: Vec<f64>,
+    },
     /// No node was given.
     #[error("point {point:?} m has no nodes")]
     NoNodes {
@@ -79,6 +85,10 @@ pub enum LmeError {
         point: Vec<f64>,
     },
 }
+
+/// `|r| / h` below which a Newton iteration that no longer halves the residual has reached
+/// round-off (OTM.md's stopping tolerance).
+const STALL: f64 = 1e-10;
 
 /// `|λ| h` beyond which the point counts as outside the hull: the weights then differ by
 /// `exp(|λ| h)` across one spacing, far beyond any interior solution (|λ| h ≲ 2 γ there).
@@ -151,12 +161,20 @@ pub fn shape_functions<const D: usize>(
     };
     let mut f = log_z(x, nodes, beta, lambda, values);
     let mut iterations = 0;
+    let mut previous = f64::INFINITY;
     loop {
         let sum: f64 = values.iter().sum();
         values.iter_mut().for_each(|w| *w /= sum);
         let (r, j) = residual_and_hessian(x, nodes, values);
         let res = r.norm() / h;
-        if res <= params.tolerance {
+        if !res.is_finite() {
+            return Err(LmeError::NotFinite { point: point() });
+        }
+        // Converged; or stalled at round-off (|r| below 1e-10 h, OTM.md's tolerance, and no
+        // longer halving), which many nodes' sums can reach before 1e-13 h.
+        let stalled = res <= STALL && res > 0.5 * previous;
+        previous = res;
+        if res <= params.tolerance || stalled {
             // ∇p_a = −p_a J⁻¹ (x − x_a) (A&O eq. 26).
             let j_inv = j.try_inverse().ok_or_else(|| outside(lambda, res))?;
             for ((g, pa), xa) in gradients.iter_mut().zip(values.iter()).zip(nodes) {
@@ -175,8 +193,9 @@ pub fn shape_functions<const D: usize>(
             .or_else(|| (j + SMatrix::<f64, D, D>::identity() * (r.norm() * h)).cholesky())
             .map(|c| -c.solve(&r))
             .ok_or_else(|| outside(lambda, res))?;
-        // Backtracking on the convex log Z: halve until it decreases (Armijo, c = 1e-4) or
-        // the change is at round-off level, where log Z cannot tell steps apart any more.
+        // Backtracking on the convex log Z: halve until it decreases enough (Armijo,
+        // c = 1e-4), or at all where the change is at round-off level and log Z cannot tell
+        // steps apart any more.
         let slope = r.dot(&step);
         let round_off = 1e-13 * (1.0 + f.abs());
         let mut t = 1.0;

@@ -3,9 +3,10 @@
 //! pressures: what the probes, frames and guards read), the nodes in the scheme's own
 //! data; one stage, `otm_step` ([`super::step::Body::step`]).
 //!
-//! The time step ([`Otm::stable_step`]) is `min(α_c h/(c₀ + |v|_max), α_d ρ h²/μ, max)`
-//! over the nodes, h = dx. The profiler's save and restore cover the particles only: the
-//! nodes are not restored (the benches do not step OTM scenes).
+//! The time step ([`Otm::stable_step`]) is `min(α_c h/(c₀ + |v|_max), α_d ρ h²/μ,
+//! the capillary limit, max)` over the nodes, h = dx ([`crate::time_step`]). The
+//! profiler's save and restore cover the particles only: the nodes are not restored (the
+//! benches do not step OTM scenes).
 
 use super::lme::LmeParams;
 use super::mesh::{Mesh, Point, disc, rectangle};
@@ -92,9 +93,16 @@ impl<const D: usize> Scheme<D> for Otm {
         // the density ρ₀ + p/c₀² over its area.
         for p in 0..body.points.len() {
             let pressure = initial_pressure::<2>(field, &body.points[p], params.density, &params.gravity);
+            let density = params.density + pressure / (params.sound_speed * params.sound_speed);
+            if density.is_nan() || density <= 0.0 {
+                return Err(SceneError::new(
+                    "bodies[0].pressure",
+                    format!("{pressure:e} Pa at ({:e}, {:e}) m", body.points[p].x, body.points[p].y),
+                    "gives a non-positive density ρ₀ + p/c₀² through the otm equation of state",
+                ));
+            }
             body.pressure[p] = pressure;
-            body.mass[p] =
-                body.volume[p] * (params.density + pressure / (params.sound_speed * params.sound_speed));
+            body.mass[p] = body.volume[p] * density;
         }
         let mut state = crate::setup::fluid_state::<D>(scene, kernel.h);
         let n = body.points.len();
@@ -106,12 +114,20 @@ impl<const D: usize> Scheme<D> for Otm {
         p.p = body.pressure.clone();
         p.div_r = vec![0.0; n];
         p.free_surface = vec![false; n];
+        // The probes' particle mass is ρ × volume: the points' mean area (the triangles of
+        // the mesh, about dx²/2), not dx².
+        state.volume = body.area() / n as f64;
         let stages: Vec<Box<dyn Stage<D, OtmData<D>>>> = vec![Box::new(OtmStep)];
         Ok(Composed { scheme: Otm, state, own: OtmData { body: Some(body) }, stages })
     }
 
     fn stable_step(&self, rule: Adaptive, _state: &State<D>, own: &OtmData<D>) -> f64 {
-        own.body.as_ref().map_or(rule.max, |b| b.stable_step(rule.cfl, rule.viscous).min(rule.max))
+        own.body.as_ref().map_or(rule.max, |b| {
+            let OtmParams { density, surface_tension, .. } = b.params;
+            b.stable_step(rule.cfl, rule.viscous)
+                .min(crate::time_step::capillary(density, b.h, surface_tension))
+                .min(rule.max)
+        })
     }
 }
 

@@ -314,16 +314,16 @@ fn validate_ppe(field: &str, ppe: &PpeOptions) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// The rules of the MPS options (MPS.md) and of what the MPS step does not have.
 /// The OTM scheme runs one 2D fluid body (a circle or a rectangle, meshed at `dx`)
 /// without walls, periodic or open boundaries (not built yet: issue #38).
 fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
     positive("scheme.otm.sound_speed", o.sound_speed)?;
-    if !(o.locality.is_finite() && o.locality > 0.0) {
+    if !(o.locality.is_finite() && o.locality > 0.0 && o.locality <= 10.0) {
         return Err(SceneError::new(
             "scheme.otm.locality",
             o.locality,
-            "must be a positive number (the LME locality γ, β = γ / dx²; 0.8 to 4 is usual, 1.5 the default)",
+            "must lie in (0, 10] (the LME locality γ, β = γ / dx²; 0.8 to 4 is usual, 1.5 the default: \
+             above 10 a point's support holds hardly more than its own triangle)",
         ));
     }
     if scene.dimension != 2 {
@@ -366,6 +366,7 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
     Ok(())
 }
 
+/// The rules of the MPS options (MPS.md) and of what the MPS step does not have.
 fn validate_mps(o: &MpsOptions, scene: &Scene) -> Result<(), SceneError> {
     validate_ppe("scheme.mps.ppe", &o.ppe)?;
     let r = o.radii();
