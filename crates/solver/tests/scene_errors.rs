@@ -178,7 +178,7 @@ fn malformed_scene_table() {
         // `sound_speed` is required.
         ("scheme.wcsph", "sound_speed", |v| v["scheme"] = json!({"wcsph": {}})),
         ("scheme.mps", "gamma", |v| v["scheme"] = json!({"mps": {}})),
-        ("scheme", "", |v| v["scheme"] = json!({"otm": {}})),
+        ("scheme", "", |v| v["scheme"] = json!({"lbm": {}})),
         ("scheme.wcsph.sound_speed", "positive", |v| v["scheme"] = json!({"wcsph": {"sound_speed": -10.0}})),
         ("scheme.wcsph.sound_speed", "positive", |v| v["scheme"] = json!({"wcsph": {"sound_speed": 0.0}})),
         ("scheme.wcsph.shifting.xu.coefficient", "at most 1", |v| {
