@@ -155,10 +155,15 @@ pub enum Cause {
         /// Columns of ghosts in reserve at the start.
         reserve: usize,
     },
-    /// An OTM body failed (a material point left its nodes' hull, or the nodal map folded
-    /// a point's volume).
-    #[error("{0}")]
-    Otm(crate::otm::step::OtmError),
+    /// An OTM body failed: a material point left its nodes' hull, or the nodal map folded
+    /// its volume (`crate::otm::step::OtmError`, as text).
+    #[error("material point {point}: {reason}")]
+    Otm {
+        /// The material point's index.
+        point: usize,
+        /// What failed.
+        reason: String,
+    },
     /// The adaptive time step fell below its floor.
     #[error(
         "time step {dt:.3e} s fell below the floor {floor:.3e} s (1e-9 of time.end): the flow is too fast or too viscous for the adaptive step"

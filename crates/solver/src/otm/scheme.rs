@@ -142,7 +142,7 @@ impl<const D: usize> Stage<D, OtmData<D>> for OtmStep {
 
     fn run(&mut self, state: &mut State<D>, own: &mut OtmData<D>, ctx: &StepContext) -> Result<(), Cause> {
         let Some(body) = own.body.as_mut() else { return Ok(()) };
-        body.step(ctx.dt).map_err(Cause::Otm)?;
+        body.step(ctx.dt).map_err(super::step::OtmError::cause)?;
         let p = &mut state.particles;
         for (x, px) in p.x.iter_mut().zip(&body.points) {
             *x = lift::<D>(px);

@@ -18,6 +18,7 @@
 
 use super::lme::{LmeError, LmeParams, shape_functions};
 use super::mesh::{Mesh, Point};
+use crate::error::Cause;
 use nalgebra::Matrix2;
 
 /// Physical and numerical parameters of an OTM body.
@@ -95,6 +96,21 @@ pub enum OtmError {
         /// det ΔF.
         det: f64,
     },
+}
+
+impl OtmError {
+    /// The failing material point and what happened to it, for the solver's [`Cause::Otm`].
+    pub fn cause(self) -> Cause {
+        match self {
+            OtmError::Shape { point, source } => Cause::Otm { point, reason: source.to_string() },
+            OtmError::Inverted { point, volume, det } => Cause::Otm {
+                point,
+                reason: format!(
+                    "volume {volume:e} m² after the update (det ΔF = {det:e}): the nodal map folded"
+                ),
+            },
+        }
+    }
 }
 
 impl Body {
