@@ -30,6 +30,71 @@ impl ProbeRecord {
     }
 }
 
+/// How many copies around the axis stand for each ring of an axisymmetric body in the
+/// probes ([`State::axis`]): eight, so that the moments up to the second (centroid,
+/// ellipsoid axes, kinetic energy, momenta) are the rings' exactly (`Σ_k cos² θ_k = K/2`
+/// for K ≥ 3 equally spaced angles).
+pub const AZIMUTHS: usize = 8;
+
+/// The rings of an axisymmetric body as [`AZIMUTHS`] copies each, at the angles
+/// `θ_k = 2πk/K` about the axis: positions, velocities `(u_r cos θ, u_r sin θ, u_z)`,
+/// pressures and volumes (the ring's over K).
+#[derive(Debug, Default)]
+struct Revolved<const D: usize> {
+    x: Vec<Vector<D>>,
+    u: Vec<Vector<D>>,
+    p: Vec<f64>,
+    volume: Vec<f64>,
+}
+
+impl<const D: usize> Revolved<D> {
+    /// Fills the copies from the fluid particles of `s`, the axis through `axis` along z.
+    fn revolve(&mut self, s: &State<D>, axis: [f64; 2]) {
+        let n = s.particles.fluid;
+        self.x.clear();
+        self.u.clear();
+        self.p.clear();
+        self.volume.clear();
+        for a in 0..n {
+            let (x, u) = (&s.particles.x[a], &s.particles.u[a]);
+            let r = x[0] - axis[0];
+            for k in 0..AZIMUTHS {
+                let (sin, cos) = (2.0 * std::f64::consts::PI * k as f64 / AZIMUTHS as f64).sin_cos();
+                let mut xk = *x;
+                let mut uk = *u;
+                xk[0] = axis[0] + r * cos;
+                xk[1] = axis[1] + r * sin;
+                uk[0] = u[0] * cos;
+                uk[1] = u[0] * sin;
+                self.x.push(xk);
+                self.u.push(uk);
+                self.p.push(s.particles.p[a]);
+                self.volume.push(s.volumes[a] / AZIMUTHS as f64);
+            }
+        }
+    }
+}
+
+/// The centroid and the second central moments (per axis) of the points `x` \[m, m²\],
+/// weighted by `weights` (equal weights when `None`).
+fn moments<const D: usize>(x: &[Vector<D>], weights: Option<&[f64]>) -> (Vector<D>, Vector<D>) {
+    match weights {
+        None => {
+            let n = x.len() as f64;
+            let c: Vector<D> = x.iter().sum::<Vector<D>>() / n;
+            let m2 = x.iter().map(|p| (p - c).component_mul(&(p - c))).sum::<Vector<D>>() / n;
+            (c, m2)
+        }
+        Some(w) => {
+            let total: f64 = w.iter().sum();
+            let c: Vector<D> = x.iter().zip(w).map(|(p, w)| p * *w).sum::<Vector<D>>() / total;
+            let m2 =
+                x.iter().zip(w).map(|(p, w)| (p - c).component_mul(&(p - c)) * *w).sum::<Vector<D>>() / total;
+            (c, m2)
+        }
+    }
+}
+
 /// Per-bin sums of a profile: Σ position, Σ velocity, count.
 type Bins = (Vec<f64>, Vec<f64>, Vec<usize>);
 
@@ -96,6 +161,8 @@ pub struct ProbeSet<const D: usize> {
     /// Own neighbour search of the drop-shape probe (pairs closer than 2 Δx) and its
     /// union-find parents.
     clusters: Option<(CellSearch<D>, NeighbourList, Vec<u32>)>,
+    /// Scratch: the rings of an axisymmetric body as copies around the axis.
+    view: Revolved<D>,
 }
 
 impl<const D: usize> ProbeSet<D> {
@@ -111,31 +178,44 @@ impl<const D: usize> ProbeSet<D> {
             .iter()
             .any(|(_, p)| matches!(p, Probe::DropShape {}))
             .then(|| (CellSearch::new(2.0 * dx, domain), NeighbourList::default(), Vec::new()));
-        Self { probes, weight, search, bins: Default::default(), clusters }
+        Self { probes, weight, search, bins: Default::default(), clusters, view: Revolved::default() }
     }
 
     /// Appends one sample of every probe at time `t`.
     pub fn record(&mut self, s: &State<D>, t: f64, out: &mut ProbeRecord) {
         out.t.push(t);
         let nf = s.particles.fluid;
-        let x = &s.particles.x[..nf];
-        let u = &s.particles.u[..nf];
+        let mut view = std::mem::take(&mut self.view);
+        let (x, u, pressure, weights) = match s.axis {
+            Some(axis) => {
+                view.revolve(s, axis);
+                (&view.x[..], &view.u[..], &view.p[..], Some(&view.volume[..]))
+            }
+            None => (
+                &s.particles.x[..nf],
+                &s.particles.u[..nf],
+                &s.particles.p[..nf],
+                (!s.volumes.is_empty()).then(|| &s.volumes[..nf]),
+            ),
+        };
         let mass = s.density * s.volume;
+        // Σ over the particles of `f(a)` times the particle's mass \[kg × f\].
+        let mass_sum = |f: &dyn Fn(usize) -> f64| -> f64 {
+            match weights {
+                None => (0..x.len()).map(|a| mass * f(a)).sum(),
+                Some(w) => (0..x.len()).map(|a| s.density * w[a] * f(a)).sum(),
+            }
+        };
         for (key, probe) in &self.probes {
             match probe {
                 Probe::EllipseAxes {} => {
-                    let n = x.len() as f64;
-                    let c: Vector<D> = x.iter().sum::<Vector<D>>() / n;
-                    let mut m2 = Vector::<D>::zeros();
+                    let (c, m2) = moments(x, weights);
                     let mut lo = Vector::<D>::repeat(f64::INFINITY);
                     let mut hi = Vector::<D>::repeat(f64::NEG_INFINITY);
                     for p in x {
-                        let d = p - c;
-                        m2 += d.component_mul(&d);
                         lo = lo.inf(p);
                         hi = hi.sup(p);
                     }
-                    m2 /= n;
                     out.push(key, "a_moment", 2.0 * m2[0].sqrt());
                     out.push(key, "b_moment", 2.0 * m2[1].sqrt());
                     out.push(key, "a_extent", 0.5 * (hi[0] - lo[0]));
@@ -150,7 +230,7 @@ impl<const D: usize> ProbeSet<D> {
                         let r = s.domain.displacement(p, &q).norm();
                         if r < self.weight.support {
                             let w = (self.weight.w)(r);
-                            num += w * s.particles.p[a];
+                            num += w * pressure[a];
                             den += w;
                         }
                     }
@@ -158,20 +238,21 @@ impl<const D: usize> ProbeSet<D> {
                 }
                 Probe::MeanPressure { center, radius } => {
                     let q = Vector::<D>::from_fn(|i, _| center[i]);
-                    let (mut sum, mut count) = (0.0, 0usize);
+                    // Σ V p and Σ V over the particles within the radius (V = 1 when equal).
+                    let (mut sum, mut volume, mut count) = (0.0, 0.0, 0usize);
                     for (a, p) in x.iter().enumerate() {
                         if s.domain.displacement(p, &q).norm() <= *radius {
-                            sum += s.particles.p[a];
+                            let v = weights.map_or(1.0, |w| w[a]);
+                            sum += v * pressure[a];
+                            volume += v;
                             count += 1;
                         }
                     }
-                    out.push(key, "p", if count > 0 { sum / count as f64 } else { f64::NAN });
+                    out.push(key, "p", if count > 0 { sum / volume } else { f64::NAN });
                     out.push(key, "count", count as f64);
                 }
                 Probe::EllipsoidAxes {} => {
-                    let n = x.len() as f64;
-                    let c: Vector<D> = x.iter().sum::<Vector<D>>() / n;
-                    let m2 = x.iter().map(|p| (p - c).component_mul(&(p - c))).sum::<Vector<D>>() / n;
+                    let (c, m2) = moments(x, weights);
                     for (i, name) in ["a_moment", "b_moment", "c_moment"].iter().enumerate().take(D) {
                         out.push(key, name, (5.0 * m2[i]).sqrt());
                     }
@@ -180,20 +261,20 @@ impl<const D: usize> ProbeSet<D> {
                     }
                 }
                 Probe::KineticEnergy {} => {
-                    let e: f64 = u.iter().map(|v| 0.5 * mass * v.norm_squared()).sum();
+                    let e = mass_sum(&|a| 0.5 * u[a].norm_squared());
                     out.push(key, "e", e);
                 }
                 Probe::Momentum {} => {
-                    let p: Vector<D> = u.iter().sum::<Vector<D>>() * mass;
+                    let p: Vector<D> = match weights {
+                        None => u.iter().sum::<Vector<D>>() * mass,
+                        Some(w) => u.iter().zip(w).map(|(v, w)| v * (s.density * w)).sum(),
+                    };
                     for (i, name) in ["px", "py", "pz"].iter().enumerate().take(D) {
                         out.push(key, name, p[i]);
                     }
-                    let lz: f64 = x.iter().zip(u).map(|(r, v)| mass * (r[0] * v[1] - r[1] * v[0])).sum();
-                    out.push(key, "lz", lz);
+                    let l = |i: usize, j: usize| mass_sum(&|a| x[a][i] * u[a][j] - x[a][j] * u[a][i]);
+                    out.push(key, "lz", l(0, 1));
                     if D == 3 {
-                        let l = |i: usize, j: usize| -> f64 {
-                            x.iter().zip(u).map(|(r, v)| mass * (r[i] * v[j] - r[j] * v[i])).sum()
-                        };
                         out.push(key, "lx", l(1, 2));
                         out.push(key, "ly", l(2, 0));
                     }
@@ -201,7 +282,7 @@ impl<const D: usize> ProbeSet<D> {
                 Probe::Disorder {} => {
                     let (search, list) = self.search.as_mut().expect("built for a disorder probe");
                     search.build(x, list);
-                    let (min_pair, close) = disorder(s, list);
+                    let (min_pair, close) = disorder(s, x, list);
                     out.push(key, "min_pair_over_dx", min_pair / s.dx);
                     out.push(key, "close_fraction", close);
                 }
@@ -238,16 +319,22 @@ impl<const D: usize> ProbeSet<D> {
                     profile_bins::write(&self.bins, out, key, "r");
                 }
                 Probe::MassBalance {} => {
-                    out.push(key, "mass", mass * nf as f64);
+                    let total = match weights {
+                        None => mass * nf as f64,
+                        Some(w) => s.density * w.iter().sum::<f64>(),
+                    };
+                    out.push(key, "mass", total);
                     out.push(key, "inflow", s.flux.inflow);
                     out.push(key, "outflow", s.flux.outflow);
                 }
                 Probe::MaxSpeed {} => {
-                    let n = u.len().max(1) as f64;
-                    let (max2, sum2) =
-                        u.iter().map(|v| v.norm_squared()).fold((0.0f64, 0.0), |(m, s), v| (m.max(v), s + v));
+                    let max2 = u.iter().map(|v| v.norm_squared()).fold(0.0f64, f64::max);
+                    let rms2 = match weights {
+                        None => u.iter().map(|v| v.norm_squared()).sum::<f64>() / u.len().max(1) as f64,
+                        Some(w) => mass_sum(&|a| u[a].norm_squared()) / (s.density * w.iter().sum::<f64>()),
+                    };
                     out.push(key, "u_max", max2.sqrt());
-                    out.push(key, "u_rms", (sum2 / n).sqrt());
+                    out.push(key, "u_rms", rms2.sqrt());
                 }
                 Probe::DropShape {} => {
                     let (search, list, parent) =
@@ -279,6 +366,7 @@ impl<const D: usize> ProbeSet<D> {
                 }
             }
         }
+        self.view = view;
     }
 }
 
@@ -320,8 +408,7 @@ fn spread<const D: usize>(
 
 /// Smallest pair distance \[m\] (Δx when no pair is closer) and the fraction of particles
 /// with a neighbour closer than 0.5 Δx; `list` holds the pairs closer than Δx.
-fn disorder<const D: usize>(s: &State<D>, list: &NeighbourList) -> (f64, f64) {
-    let x = &s.particles.x[..s.particles.fluid];
+fn disorder<const D: usize>(s: &State<D>, x: &[Vector<D>], list: &NeighbourList) -> (f64, f64) {
     let mut min = s.dx;
     let mut close = 0usize;
     for a in 0..x.len() {

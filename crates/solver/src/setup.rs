@@ -78,6 +78,8 @@ fn state_around<const D: usize>(
         neighbours: Default::default(),
         pairs: Vec::new(),
         volume: scene.dx.powi(D as i32),
+        volumes: Vec::new(),
+        axis: None,
         density: scene.fluid.density,
         dx: scene.dx,
         h,

@@ -90,8 +90,18 @@ pub struct State<const D: usize> {
     pub neighbours: NeighbourList,
     /// Pair geometry, aligned with `neighbours.indices`.
     pub pairs: Vec<Pair<D>>,
-    /// Particle volume V = Δx^D \[m^D\] (equal for all particles).
+    /// Particle volume V = Δx^D \[m^D\] (equal for all particles, unless `volumes` says
+    /// otherwise).
     pub volume: f64,
+    /// Each fluid particle's own volume \[m^D\] where they differ (OTM's material points:
+    /// the probes weight by it), empty where every particle has `volume`.
+    pub volumes: Vec<f64>,
+    /// Set where the fluid particles are the material points of an axisymmetric body (OTM
+    /// in 3D, Zhou 2021 §2.3.3): the axis is parallel to z through this (x, y) point, the
+    /// particle at (x + r, y, z) stands for the ring of radius r it traces about the axis,
+    /// and `volumes` holds the rings' volumes. The probes see each ring as
+    /// [`crate::probes::AZIMUTHS`] copies around the axis.
+    pub axis: Option<[f64; 2]>,
     /// Density ρ \[kg/m³\].
     pub density: f64,
     /// Initial spacing Δx \[m\].
