@@ -97,3 +97,92 @@ fn a_folded_map_stops_the_run_with_a_typed_error() {
     assert!(text.contains("material point") && text.contains("at step"), "{text}");
     assert!(!report.probes.get("mean_pressure", "p").expect("kept").is_empty());
 }
+
+/// Zhou's static drop as a ball (axisymmetric OTM) from a 3D scene file: the probes see
+/// the rings about the z axis through the centre, so the mean pressure within R/2 is the
+/// Laplace jump 2σ/R = 10 Pa within 1 % (0.47 % measured at R/10 to 0.1 s), the centroid
+/// is the centre and the ellipsoid axes are the ball's (√(5⟨x²⟩) = R for a uniform ball).
+#[test]
+fn the_axisymmetric_static_drop_settles_at_twice_the_laplace_pressure() {
+    let mut v = static_drop(0.02, 0.1);
+    v["dimension"] = json!(3);
+    v["body_force"] = json!([0.0, 0.0, 0.0]);
+    v["bodies"][0]["shape"] = json!({"sphere": {"center": [0.1, -0.2, 0.3], "radius": 0.2}});
+    v["probes"] = json!([{"mean_pressure": {"center": [0.1, -0.2, 0.3], "radius": 0.1}},
+                         {"ellipsoid_axes": {}}, {"momentum": {}}]);
+    let scene = Scene::from_json(&v.to_string()).expect("valid scene");
+    let report = meniscus::run(&scene, &mut Quiet).expect("builds");
+    assert!(report.error.is_none(), "{:?}", report.error);
+    let last = |k: &str, q: &str| *report.probes.get(k, q).expect("recorded").last().unwrap();
+    let p = last("mean_pressure", "p");
+    assert!((p / 10.0 - 1.0).abs() < 0.01, "mean pressure {p} Pa");
+    assert_eq!(report.summary.particles, 900, "three material points per triangle, 3 K² triangles");
+    for (q, c) in [("x_centroid", 0.1), ("y_centroid", -0.2), ("z_centroid", 0.3)] {
+        assert!((last("ellipsoid_axes", q) - c).abs() < 1e-3, "{q}");
+    }
+    for q in ["a_moment", "b_moment", "c_moment"] {
+        assert!((last("ellipsoid_axes", q) / 0.2 - 1.0).abs() < 0.01, "{q}: {}", last("ellipsoid_axes", q));
+    }
+    assert!(last("momentum", "px").abs() < 1e-12 && last("momentum", "lz").abs() < 1e-12);
+}
+
+#[test]
+fn a_3d_otm_scene_must_be_a_ball_about_z() {
+    let mut v = static_drop(0.02, 0.1);
+    v["dimension"] = json!(3);
+    v["body_force"] = json!([0.0, 0.0, 0.0]);
+    v["bodies"][0]["shape"] = json!({"box": {"min": [0.0, 0.0, 0.0], "max": [0.2, 0.2, 0.2]}});
+    v["probes"] = json!([{"max_speed": {}}]);
+    let e = error_of(v.clone()).to_string();
+    assert!(e.contains("bodies[0].shape") && e.contains("axisymmetric"), "{e}");
+    v["bodies"][0]["shape"] = json!({"sphere": {"center": [0.0, 0.0, 0.0], "radius": 0.2}});
+    v["body_force"] = json!([1.0, 0.0, -9.81]);
+    let e = error_of(v).to_string();
+    assert!(e.contains("body_force[0]") && e.contains("along z"), "{e}");
+}
+
+/// A periodic channel between no-slip walls (the rectangle's edges: its nodes there held at
+/// rest, its two ends merged across the period), driven by a body force: after D²/ν the
+/// profile is the parabola `g y (D − y) / (2ν)` within 2 % (L2 over the bins), the flow
+/// stays along x, and the run is the same on one thread and on two.
+#[test]
+fn a_periodic_channel_between_walls_reaches_the_poiseuille_profile() {
+    let (d, nu, g) = (0.2, 0.1, 1.0);
+    let v = json!({
+        "name": "otm_channel",
+        "dimension": 2,
+        "dx": 0.02,
+        "kernel": {"kind": "cubic_spline", "h_over_dx": 1.5},
+        "fluid": {"density": 1.0, "viscosity": nu},
+        "body_force": [g, 0.0],
+        "bodies": [{"role": "fluid", "shape": {"rectangle": {"min": [0.0, 0.0], "max": [0.2, d]}}}],
+        "boundaries": {
+            "periodic": [{"axis": 0, "min": 0.0, "max": 0.2}],
+            "walls": [{"axis": 1, "position": 0.0, "fluid_side": "above"},
+                      {"axis": 1, "position": d, "fluid_side": "below"}]
+        },
+        "scheme": {"otm": {"sound_speed": 0.5, "locality": 4.0}},
+        "time": {"end": d * d / nu, "step": {"adaptive": {"cfl": 0.25, "viscous": 0.2, "max": 0.01}}},
+        "probes": [{"velocity_profile": {"axis": 1, "component": 0, "range": [0.0, d]}}, {"momentum": {}}],
+        "output": {"probe_every": 50}
+    });
+    let scene = Scene::from_json(&v.to_string()).expect("valid scene");
+    let report = meniscus::run(&scene, &mut Quiet).expect("builds");
+    assert!(report.error.is_none(), "{:?}", report.error);
+    let (mut num, mut den) = (0.0, 0.0);
+    for k in 0..10 {
+        let y = *report.probes.get("velocity_profile", &format!("y_{k:03}")).unwrap().last().unwrap();
+        let u = *report.probes.get("velocity_profile", &format!("u_{k:03}")).unwrap().last().unwrap();
+        let exact = g * y * (d - y) / (2.0 * nu);
+        num += (u - exact).powi(2);
+        den += exact * exact;
+    }
+    let l2 = (num / den).sqrt();
+    assert!(l2 < 0.02, "profile L2 error {l2}");
+    let py = report.probes.get("momentum", "py").unwrap().last().unwrap().abs();
+    let px = report.probes.get("momentum", "px").unwrap().last().unwrap().abs();
+    assert!(py < 1e-6 * px, "{py} against {px}");
+    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
+    let again = one.install(|| meniscus::run(&scene, &mut Quiet).expect("builds"));
+    assert_eq!(again.probes, report.probes, "bit for bit on one thread");
+}

@@ -2,10 +2,12 @@
 //! triangles' vertices, one material point per triangle at its centroid; the connectivity
 //! is used once, for the material points and the boundary polyline, then dropped.
 //!
-//! Only the bodies of Zhou's 2D cases are needed (a disc, a rectangle), both with a
-//! structured triangulation, which a general mesher would not improve on: a disc of
-//! concentric rings of 6k nodes (equal spacing 2πR/(6K) on every ring, joined ring to ring
-//! by advancing along both in angle), a rectangle of a grid with alternating diagonals.
+//! Only the bodies of Zhou's cases are needed (a disc, a rectangle, and the half-disc that
+//! is a ball's (r, z) section), all with a structured triangulation, which a general
+//! mesher would not improve on: a disc of concentric rings of 6k nodes (equal spacing
+//! 2πR/(6K) on every ring, joined ring to ring by advancing along both in angle), a
+//! half-disc of half-rings of 3k + 1 nodes joined the same way, a rectangle of a grid with
+//! alternating diagonals.
 //! Written here rather than taken from a Delaunay crate for that reason (the rings fix the
 //! nodes, and their connection is the zipper below).
 
@@ -24,6 +26,9 @@ pub struct Mesh {
     pub triangles: Vec<[usize; 3]>,
     /// The boundary nodes as a closed polyline, counter-clockwise.
     pub boundary: Vec<usize>,
+    /// The nodes on the symmetry axis x = centre of a [`half_disc`] (ascending), empty for
+    /// plane bodies.
+    pub axis: Vec<usize>,
 }
 
 /// A body the mesher cannot triangulate: names the field, the value and the rule.
@@ -47,6 +52,21 @@ impl Mesh {
             .map(|t| {
                 let [a, b, c] = t.map(|i| self.nodes[i]);
                 ((a + b + c) / 3.0, signed_area(a, b, c))
+            })
+            .collect()
+    }
+
+    /// Three points per triangle at the barycentric points (2/3, 1/6, 1/6) of the
+    /// degree-two rule (Strang & Fix), each with a third of the area \[m, m²\]: the
+    /// material points of an axisymmetric body, whose integrands carry the factor r.
+    pub fn material_points_degree_two(&self) -> Vec<(Point, f64)> {
+        self.triangles
+            .iter()
+            .flat_map(|t| {
+                let [a, b, c] = t.map(|i| self.nodes[i]);
+                let third = signed_area(a, b, c) / 3.0;
+                let at = |p: Point, q: Point, r: Point| (p * (2.0 / 3.0) + (q + r) / 6.0, third);
+                [at(a, b, c), at(b, c, a), at(c, a, b)]
             })
             .collect()
     }
@@ -94,26 +114,78 @@ pub fn disc(centre: Point, radius: f64, h: f64) -> Result<Mesh, MeshError> {
     for i in 0..6 {
         triangles.push([0, first[1] + i, first[1] + (i + 1) % 6]);
     }
-    // Ring k to ring k + 1: advance along whichever ring's next node comes first in angle.
     for k in 1..rings {
-        let (n_in, n_out) = (6 * k, 6 * (k + 1));
-        let (mut i, mut j) = (0, 0);
-        while i < n_in || j < n_out {
-            let inner = |i: usize| first[k] + i % n_in;
-            let outer = |j: usize| first[k + 1] + j % n_out;
-            let next_in = (i + 1) as f64 / n_in as f64;
-            let next_out = (j + 1) as f64 / n_out as f64;
-            if j < n_out && (i == n_in || next_out <= next_in) {
-                triangles.push([inner(i), outer(j), outer(j + 1)]);
-                j += 1;
-            } else {
-                triangles.push([inner(i), outer(j), inner(i + 1)]);
-                i += 1;
-            }
-        }
+        zip(&mut triangles, (first[k], 6 * k), (first[k + 1], 6 * (k + 1)), true);
     }
     let boundary = (first[rings]..nodes.len()).collect();
-    Ok(Mesh { nodes, triangles, boundary })
+    Ok(Mesh { nodes, triangles, boundary, axis: Vec::new() })
+}
+
+/// Joins two rings of a disc (or two arcs of a half-disc) by triangles: `inner` and
+/// `outer` are (first node, number of segments); advancing along whichever ring's next
+/// node comes first in angle. A closed ring's last segment returns to its first node; an
+/// open arc has one node more than segments.
+fn zip(triangles: &mut Vec<[usize; 3]>, inner: (usize, usize), outer: (usize, usize), closed: bool) {
+    let ((f_in, n_in), (f_out, n_out)) = (inner, outer);
+    let node = |first: usize, n: usize, i: usize| first + if closed { i % n } else { i };
+    let (mut i, mut j) = (0, 0);
+    while i < n_in || j < n_out {
+        let next_in = (i + 1) as f64 / n_in as f64;
+        let next_out = (j + 1) as f64 / n_out as f64;
+        if j < n_out && (i == n_in || next_out <= next_in) {
+            triangles.push([node(f_in, n_in, i), node(f_out, n_out, j), node(f_out, n_out, j + 1)]);
+            j += 1;
+        } else {
+            triangles.push([node(f_in, n_in, i), node(f_out, n_out, j), node(f_in, n_in, i + 1)]);
+            i += 1;
+        }
+    }
+}
+
+/// The right half (x ≥ `centre.x`) of a disc of `radius` with node spacing about `h` \[m\]:
+/// the (r, z) section of a ball about the axis x = `centre.x` (axisymmetric bodies, Zhou
+/// 2021 §2.3.3). K = round(R/h) half-rings, half-ring k of radius kR/K with 3k + 1 nodes
+/// from the bottom pole to the top pole (the same spacing πR/(3K) as [`disc`]'s rings),
+/// its end nodes exactly on the axis. The boundary polygon starts with the free arc, from
+/// the bottom pole up to the top pole; the rest of it lies on the axis.
+pub fn half_disc(centre: Point, radius: f64, h: f64) -> Result<Mesh, MeshError> {
+    positive("radius", radius)?;
+    positive("spacing", h)?;
+    let rings = (radius / h).round() as usize;
+    if rings == 0 {
+        return Err(MeshError {
+            field: "spacing",
+            value: h,
+            rule: "must be at most twice the radius (one ring)",
+        });
+    }
+    let mut nodes = vec![centre];
+    let mut first = vec![0];
+    for k in 1..=rings {
+        first.push(nodes.len());
+        let r = radius * k as f64 / rings as f64;
+        for i in 0..=3 * k {
+            let t = PI * (i as f64 / (3 * k) as f64 - 0.5);
+            let x = if i == 0 || i == 3 * k { 0.0 } else { r * t.cos() };
+            nodes.push(centre + Point::new(x, r * t.sin()));
+        }
+    }
+    let mut triangles = Vec::with_capacity(3 * rings * rings);
+    for i in 0..3 {
+        triangles.push([0, first[1] + i, first[1] + i + 1]);
+    }
+    for k in 1..rings {
+        zip(&mut triangles, (first[k], 3 * k), (first[k + 1], 3 * (k + 1)), false);
+    }
+    let top = |k: usize| first[k] + 3 * k;
+    let mut boundary: Vec<usize> = (first[rings]..=top(rings)).collect();
+    boundary.extend((1..rings).rev().map(top));
+    boundary.push(0);
+    boundary.extend((1..rings).map(|k| first[k]));
+    let mut axis: Vec<usize> = (1..=rings).flat_map(|k| [first[k], top(k)]).collect();
+    axis.push(0);
+    axis.sort_unstable();
+    Ok(Mesh { nodes, triangles, boundary, axis })
 }
 
 /// The rectangle `lo`–`hi` with node spacing about `h` \[m\] in each direction (at least
@@ -147,7 +219,7 @@ pub fn rectangle(lo: Point, hi: Point, h: f64) -> Result<Mesh, MeshError> {
     boundary.extend((0..ny).map(|j| id(nx, j)));
     boundary.extend((1..=nx).rev().map(|i| id(i, ny)));
     boundary.extend((1..=ny).rev().map(|j| id(0, j)));
-    Ok(Mesh { nodes, triangles, boundary })
+    Ok(Mesh { nodes, triangles, boundary, axis: Vec::new() })
 }
 
 #[cfg(test)]
@@ -198,6 +270,27 @@ mod tests {
             for &b in &m.boundary {
                 assert!(((m.nodes[b] - Point::new(0.1, -0.3)).norm() - radius).abs() < 1e-12);
             }
+        }
+    }
+
+    #[test]
+    fn half_discs_are_ringed_triangulations_with_their_poles_on_the_axis() {
+        for (radius, h) in [(0.2, 0.02), (1.0, 0.3), (0.2, 0.39)] {
+            let c = Point::new(0.0, 0.3);
+            let m = half_disc(c, radius, h).unwrap();
+            let k = (radius / h).round() as usize;
+            assert_eq!(m.triangles.len(), 3 * k * k);
+            assert_eq!(m.boundary.len(), 3 * k + 1 + 2 * k - 1);
+            valid(&m);
+            // The free arc: on the circle, from the bottom pole to the top pole.
+            for &b in &m.boundary[..=3 * k] {
+                assert!(((m.nodes[b] - c).norm() - radius).abs() < 1e-12);
+            }
+            assert_eq!(m.nodes[m.boundary[0]], c - Point::new(0.0, radius));
+            assert_eq!(m.nodes[m.boundary[3 * k]], c + Point::new(0.0, radius));
+            assert_eq!(m.axis.len(), 2 * k + 1);
+            assert!(m.axis.iter().all(|&a| m.nodes[a].x == 0.0));
+            assert!(m.boundary[3 * k..].iter().all(|b| m.axis.contains(b)));
         }
     }
 

@@ -2,10 +2,12 @@
 //! 2021, seed 003; OTM.md): nodes carrying position and velocity, material points carrying
 //! mass, volume and stress, coupled by local max-entropy shape functions ([`lme`]); the
 //! bodies triangulated once at set-up ([`mesh`]); surface tension as the energy of the
-//! boundary nodes' polyline ([`surface`]); the step of a 2D body ([`step`]).
+//! boundary nodes' polyline ([`surface`]); the step of a plane or axisymmetric body, with
+//! no-slip nodes and a periodic axis ([`step`]).
 //!
-//! As a scheme of the scene file ([`scheme`]): 2D, one free body so far (issue #38 in
-//! progress; docs/notes/otm.md).
+//! As a scheme of the scene file ([`scheme`]): one body, a circle or a rectangle in 2D, a
+//! sphere solved axisymmetric in 3D; walls and a periodic axis on a rectangle's edges
+//! (issue #38 in progress; docs/notes/otm.md).
 
 pub mod lme;
 pub mod mesh;

@@ -1,7 +1,13 @@
 //! OTM as a [`Scheme`]: the scene's body meshed at `dx` ([`super::mesh`]), the material
 //! points as the shared [`State`]'s particles (positions, velocities `Σ N_a v_a`,
-//! pressures: what the probes, frames and guards read), the nodes in the scheme's own
-//! data; one stage, `otm_step` ([`super::step::Body::step`]).
+//! pressures, volumes in [`State::volumes`]: what the probes, frames and guards read), the
+//! nodes in the scheme's own data; one stage, `otm_step` ([`super::step::Body::step`]).
+//!
+//! A 2D scene is a plane body (a circle or a rectangle). A 3D scene is a ball solved in
+//! its (r, z) section about the z axis through its centre ([`Geometry::Axisymmetric`],
+//! Zhou 2021 §2.3.3): the material points are stored at `(x_c + r, y_c, z)`, each the ring
+//! it traces ([`State::axis`]), and the scene's initial fields are read on the half-plane
+//! y = y_c, x ≥ x_c (their r and z components: they must be axisymmetric).
 //!
 //! The time step ([`Otm::stable_step`]) is `min(α_c h/(c₀ + |v|_max), α_d ρ h²/μ,
 //! the capillary limit, max)` over the nodes, h = dx ([`crate::time_step`]). The
@@ -9,8 +15,8 @@
 //! benches do not step OTM scenes).
 
 use super::lme::LmeParams;
-use super::mesh::{Mesh, Point, disc, rectangle};
-use super::step::{Body, OtmParams};
+use super::mesh::{Mesh, Point, disc, half_disc, rectangle};
+use super::step::{Body, Geometry, OtmParams, Period};
 use crate::error::{Cause, SceneError};
 use crate::fields::{ColumnMut, ColumnRef, Field, Fields};
 use crate::kernel::{Kernel, Scaled};
@@ -37,26 +43,65 @@ impl<const D: usize> Fields<D> for OtmData<D> {
 #[derive(Debug)]
 pub struct Otm;
 
-/// A 2D point as the scheme's `D`-vector (`D` is 2 for every OTM scene).
-fn lift<const D: usize>(p: &Point) -> Vector<D> {
-    Vector::<D>::from_fn(|i, _| p[i])
+/// Where the body's plane lies in the scene: a plane body's (x, y) is the scene's (2D); an
+/// axisymmetric body's (r, z) is `(axis[0] + r, axis[1], z)` (3D).
+#[derive(Debug, Clone, Copy)]
+struct Placement {
+    geometry: Geometry,
+    axis: [f64; 2],
 }
 
-/// The mesh of the scene's (validated) body.
-fn mesh_of(scene: &Scene) -> Result<Mesh, SceneError> {
+impl Placement {
+    /// The body-plane point `p` as the scene's `D`-vector \[m\].
+    fn lift<const D: usize>(&self, p: &Point) -> Vector<D> {
+        match self.geometry {
+            Geometry::Plane => Vector::<D>::from_fn(|i, _| p[i]),
+            Geometry::Axisymmetric => {
+                Vector::<D>::from_fn(|i, _| [self.axis[0] + p[0], self.axis[1], p[1]][i])
+            }
+        }
+    }
+
+    /// The body-plane vector `v` as the scene's (`(v_r, 0, v_z)` axisymmetric).
+    fn lift_vector<const D: usize>(&self, v: &Point) -> Vector<D> {
+        match self.geometry {
+            Geometry::Plane => Vector::<D>::from_fn(|i, _| v[i]),
+            Geometry::Axisymmetric => Vector::<D>::from_fn(|i, _| [v[0], 0.0, v[1]][i]),
+        }
+    }
+
+    /// The scene's vector `v` at a body-plane point as the body's (the (r, z) components
+    /// on the half-plane y = y_c, axisymmetric).
+    fn lower<const D: usize>(&self, v: &Vector<D>) -> Point {
+        match self.geometry {
+            Geometry::Plane => Point::new(v[0], v[1]),
+            Geometry::Axisymmetric => Point::new(v[0], v[2]),
+        }
+    }
+}
+
+/// The mesh of the scene's (validated) body and where it lies.
+fn mesh_of(scene: &Scene) -> Result<(Mesh, Placement), SceneError> {
     let dx = scene.dx;
     let err = |e: super::mesh::MeshError| {
         SceneError::new(format!("bodies[0].shape ({})", e.field), e.value, e.rule)
     };
+    let plane = Placement { geometry: Geometry::Plane, axis: [0.0; 2] };
     match &scene.bodies[0].shape {
-        Shape::Circle { center, radius } => disc(Point::new(center[0], center[1]), *radius, dx).map_err(err),
-        Shape::Rectangle { min, max } => {
-            rectangle(Point::new(min[0], min[1]), Point::new(max[0], max[1]), dx).map_err(err)
+        Shape::Circle { center, radius } => {
+            Ok((disc(Point::new(center[0], center[1]), *radius, dx).map_err(err)?, plane))
         }
+        Shape::Rectangle { min, max } => {
+            Ok((rectangle(Point::new(min[0], min[1]), Point::new(max[0], max[1]), dx).map_err(err)?, plane))
+        }
+        Shape::Sphere { center, radius } => Ok((
+            half_disc(Point::new(0.0, center[2]), *radius, dx).map_err(err)?,
+            Placement { geometry: Geometry::Axisymmetric, axis: [center[0], center[1]] },
+        )),
         _ => Err(SceneError::new(
             "bodies[0].shape",
-            "not a circle or rectangle",
-            "the otm scheme meshes circles and rectangles",
+            "not a circle, rectangle or sphere",
+            "the otm scheme meshes circles and rectangles (2D) and spheres (3D, axisymmetric)",
         )),
     }
 }
@@ -68,31 +113,44 @@ impl<const D: usize> Scheme<D> for Otm {
         let SceneScheme::Otm(opts) = &scene.scheme else {
             return Err(SceneError::new("scheme", scene.scheme.key(), "must be `otm` for the OTM scheme"));
         };
-        if D != 2 {
-            return Err(SceneError::new("dimension", D, "the otm scheme runs 2D scenes"));
-        }
-        let mesh = mesh_of(scene)?;
+        let (mesh, place) = mesh_of(scene)?;
+        let gravity = Vector::<D>::from_fn(|i, _| scene.body_force.get(i).copied().unwrap_or(0.0));
         let params = OtmParams {
             density: scene.fluid.density,
             sound_speed: opts.sound_speed,
             viscosity: scene.fluid.viscosity,
             surface_tension: scene.fluid.surface_tension,
-            gravity: Point::new(
-                scene.body_force.first().copied().unwrap_or(0.0),
-                scene.body_force.get(1).copied().unwrap_or(0.0),
-            ),
+            gravity: place.lower(&gravity),
             lme: LmeParams { gamma: opts.locality, ..LmeParams::default() },
             support_tolerance: 1e-6,
         };
-        let mut body = Body::new(&mesh, scene.dx, params);
+        let mut body = Body::new(&mesh, scene.dx, params, place.geometry);
+        // Nodal boundary conditions (validated: edges of a rectangle). No slip: the nodes on
+        // a wall are held at rest.
+        let on = |a: f64, b: f64| (a - b).abs() <= 1e-9 * scene.dx.max(b.abs());
+        for w in &scene.boundaries.walls {
+            body.fixed.extend((0..body.nodes.len()).filter(|&a| on(body.nodes[a][w.axis], w.position)));
+        }
+        body.fixed.sort_unstable();
+        body.fixed.dedup();
+        if let Some(pd) = scene.boundaries.periodic.first() {
+            let period = Period { axis: pd.axis, min: pd.min, length: pd.max - pd.min };
+            body = body.with_period(period).map_err(|e| {
+                SceneError::new("boundaries.periodic[0]", format!("[{}, {}]", pd.min, pd.max), e)
+            })?;
+        }
         let field = &scene.bodies[0];
         for (v, x) in body.velocity.iter_mut().zip(&mesh.nodes) {
-            *v = initial_velocity::<2>(field, x);
+            *v = place.lower(&initial_velocity::<D>(field, &place.lift::<D>(x)));
+        }
+        for &a in &body.axis {
+            body.velocity[a][0] = 0.0;
         }
         // The initial pressure through the equation of state: each point's mass is that of
         // the density ρ₀ + p/c₀² over its area.
         for p in 0..body.points.len() {
-            let pressure = initial_pressure::<2>(field, &body.points[p], params.density, &params.gravity);
+            let pressure =
+                initial_pressure::<D>(field, &place.lift::<D>(&body.points[p]), params.density, &gravity);
             let density = params.density + pressure / (params.sound_speed * params.sound_speed);
             if density.is_nan() || density <= 0.0 {
                 return Err(SceneError::new(
@@ -109,15 +167,20 @@ impl<const D: usize> Scheme<D> for Otm {
         let p = &mut state.particles;
         p.fluid = n;
         p.id = (0..n as u32).collect();
-        p.x = body.points.iter().map(lift::<D>).collect();
-        p.u = body.points.iter().map(|x| lift::<D>(&initial_velocity::<2>(field, x))).collect();
+        p.x = body.points.iter().map(|x| place.lift::<D>(x)).collect();
+        p.u = body
+            .points
+            .iter()
+            .map(|x| place.lift_vector::<D>(&place.lower(&initial_velocity::<D>(field, &place.lift::<D>(x)))))
+            .collect();
         p.p = body.pressure.clone();
         p.div_r = vec![0.0; n];
         p.free_surface = vec![false; n];
-        // The probes' particle mass is ρ × volume: the points' mean area (the triangles of
-        // the mesh, about dx²/2), not dx².
+        // The probes weigh each point by its own volume; the mean stands for the rest.
+        state.volumes = body.volume.clone();
         state.volume = body.area() / n as f64;
-        let stages: Vec<Box<dyn Stage<D, OtmData<D>>>> = vec![Box::new(OtmStep)];
+        state.axis = (place.geometry == Geometry::Axisymmetric).then_some(place.axis);
+        let stages: Vec<Box<dyn Stage<D, OtmData<D>>>> = vec![Box::new(OtmStep { place })];
         Ok(Composed { scheme: Otm, state, own: OtmData { body: Some(body) }, stages })
     }
 
@@ -133,7 +196,9 @@ impl<const D: usize> Scheme<D> for Otm {
 
 /// The OTM step of the body, then its material points copied into the particles.
 #[derive(Debug)]
-struct OtmStep;
+struct OtmStep {
+    place: Placement,
+}
 
 impl<const D: usize> Stage<D, OtmData<D>> for OtmStep {
     fn name(&self) -> &'static str {
@@ -145,12 +210,13 @@ impl<const D: usize> Stage<D, OtmData<D>> for OtmStep {
         body.step(ctx.dt).map_err(super::step::OtmError::cause)?;
         let p = &mut state.particles;
         for (x, px) in p.x.iter_mut().zip(&body.points) {
-            *x = lift::<D>(px);
+            *x = self.place.lift::<D>(px);
         }
         p.p.copy_from_slice(&body.pressure);
         for (u, v) in p.u.iter_mut().zip(body.point_velocities()) {
-            *u = lift::<D>(&v);
+            *u = self.place.lift_vector::<D>(&v);
         }
+        state.volumes.copy_from_slice(&body.volume);
         Ok(())
     }
 }

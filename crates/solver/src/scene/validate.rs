@@ -326,9 +326,6 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
              above 10 a point's support holds hardly more than its own triangle)",
         ));
     }
-    if scene.dimension != 2 {
-        return Err(SceneError::new("dimension", scene.dimension, "the otm scheme runs 2D scenes"));
-    }
     let not_yet = |field: &str, value: &str| {
         Err(SceneError::new(
             field,
@@ -336,11 +333,8 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
             "is not supported by the otm scheme yet (one free body, issue #38)",
         ))
     };
-    if scene.has_walls() {
-        return not_yet("boundaries.walls", "walls");
-    }
-    if !scene.boundaries.periodic.is_empty() {
-        return not_yet("boundaries.periodic", "periodic axes");
+    if scene.bodies.iter().any(|b| b.role == Role::Wall) {
+        return not_yet("bodies", "a wall body (the otm scheme's walls are planes)");
     }
     if scene.boundaries.inflow.is_some() || scene.boundaries.outflow.is_some() {
         return not_yet("boundaries.inflow", "open boundaries");
@@ -353,7 +347,22 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
         ));
     }
     let body = &scene.bodies[0];
-    if !matches!(body.shape, Shape::Circle { .. } | Shape::Rectangle { .. }) {
+    if scene.dimension == 3 {
+        if !matches!(body.shape, Shape::Sphere { .. }) {
+            return Err(SceneError::new(
+                "bodies[0].shape",
+                "not a sphere",
+                "the otm scheme runs a 3D scene axisymmetric, about the z axis through a sphere's centre",
+            ));
+        }
+        if let Some(i) = (0..2).find(|&i| scene.body_force[i] != 0.0) {
+            return Err(SceneError::new(
+                format!("body_force[{i}]"),
+                scene.body_force[i],
+                "must be 0 for the otm scheme in 3D (axisymmetric about z: gravity along z only)",
+            ));
+        }
+    } else if !matches!(body.shape, Shape::Circle { .. } | Shape::Rectangle { .. }) {
         return Err(SceneError::new(
             "bodies[0].shape",
             "not a circle or rectangle",
@@ -362,6 +371,71 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
     }
     if body.jitter.is_some() {
         return not_yet("bodies[0].jitter", "a jittered lattice");
+    }
+    validate_otm_boundaries(o, scene)
+}
+
+/// The otm scheme's nodal boundary conditions: a periodic axis and the no-slip walls are
+/// edges of a rectangle (its nodes there are merged across the period, or held at rest),
+/// and a periodic body has no free surface to carry surface tension.
+fn validate_otm_boundaries(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
+    let b = &scene.boundaries;
+    if b.walls.is_empty() && b.periodic.is_empty() {
+        return Ok(());
+    }
+    let Shape::Rectangle { min, max } = &scene.bodies[0].shape else {
+        let field = if b.periodic.is_empty() { "boundaries.walls" } else { "boundaries.periodic" };
+        return Err(SceneError::new(
+            field,
+            "on a body that is not a rectangle",
+            "the otm scheme's walls and periodic axes are edges of a rectangular body",
+        ));
+    };
+    let on = |a: f64, b: f64| (a - b).abs() <= 1e-9 * scene.dx.max(a.abs());
+    for (i, p) in b.periodic.iter().enumerate() {
+        if !(on(p.min, min[p.axis]) && on(p.max, max[p.axis])) {
+            return Err(SceneError::new(
+                format!("boundaries.periodic[{i}]"),
+                format!("[{}, {}] on axis {}", p.min, p.max, p.axis),
+                "must be the rectangle's extent on that axis for the otm scheme (its nodes on the two edges are merged)",
+            ));
+        }
+        // The support radius dx √(ln 10⁶ / γ) (`otm::lme::LmeParams::cutoff`).
+        let support = scene.dx * (1e6f64.ln() / o.locality).sqrt();
+        if p.max - p.min <= 2.0 * support {
+            return Err(SceneError::new(
+                format!("boundaries.periodic[{i}]"),
+                p.max - p.min,
+                "must exceed twice the otm shape functions' support (a node's nearest image must be unique)",
+            ));
+        }
+    }
+    if b.periodic.len() > 1 {
+        return Err(SceneError::new(
+            "boundaries.periodic",
+            format!("{} axes", b.periodic.len()),
+            "the otm scheme takes one periodic axis",
+        ));
+    }
+    if !b.periodic.is_empty() && scene.fluid.surface_tension > 0.0 {
+        return Err(SceneError::new(
+            "fluid.surface_tension",
+            scene.fluid.surface_tension,
+            "must be 0 for the otm scheme with a periodic axis (no closed free surface to carry it)",
+        ));
+    }
+    for (i, w) in b.walls.iter().enumerate() {
+        let edge = match w.fluid_side {
+            Side::Above => min[w.axis],
+            Side::Below => max[w.axis],
+        };
+        if w.axis > 1 || !on(w.position, edge) {
+            return Err(SceneError::new(
+                format!("boundaries.walls[{i}].position"),
+                w.position,
+                "must lie on the rectangle's edge on the fluid's side for the otm scheme (its nodes there are held at rest: no slip)",
+            ));
+        }
     }
     Ok(())
 }
