@@ -251,6 +251,10 @@ pub enum ReferenceSpec {
         /// Impact speed V \[m/s\].
         speed: f64,
     },
+    /// A drop at rest on a plate under gravity (Zhou 2021 §3.4): the pressure gradient of
+    /// its interior (the `pressure_gradient` probe) against the hydrostatic `ρ g`, ρ and g
+    /// (`body_force`) from each run's scene.
+    Hydrostatic {},
     /// A 2D square of side L relaxing to a circle of radius `L/√π`: Laplace pressure,
     /// connectivity, circularity and the mode-4 period.
     SquareDrop {

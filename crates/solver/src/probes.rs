@@ -251,6 +251,32 @@ impl<const D: usize> ProbeSet<D> {
                     out.push(key, "p", if count > 0 { sum / volume } else { f64::NAN });
                     out.push(key, "count", count as f64);
                 }
+                Probe::PressureGradient { center, radius } => {
+                    let q = Vector::<D>::from_fn(|i, _| center[i]);
+                    let within = |a: &usize| s.domain.displacement(&x[*a], &q).norm() <= *radius;
+                    let weight = |a: usize| weights.map_or(1.0, |w| w[a]);
+                    let (mut sum_w, mut sum_x, mut sum_p, mut count) =
+                        (0.0, Vector::<D>::zeros(), 0.0, 0usize);
+                    for a in (0..x.len()).filter(within) {
+                        sum_w += weight(a);
+                        sum_x += x[a] * weight(a);
+                        sum_p += pressure[a] * weight(a);
+                        count += 1;
+                    }
+                    let (xm, pm) = (sum_x / sum_w, sum_p / sum_w);
+                    let mut m = crate::fields::Matrix::<D>::zeros();
+                    let mut b = Vector::<D>::zeros();
+                    for a in (0..x.len()).filter(within) {
+                        let d = x[a] - xm;
+                        m += d * d.transpose() * weight(a);
+                        b += d * ((pressure[a] - pm) * weight(a));
+                    }
+                    let g = m.try_inverse().map_or(Vector::<D>::repeat(f64::NAN), |mi| mi * b);
+                    for (i, name) in ["dp_dx", "dp_dy", "dp_dz"].iter().enumerate().take(D) {
+                        out.push(key, name, g[i]);
+                    }
+                    out.push(key, "count", count as f64);
+                }
                 Probe::EllipsoidAxes {} => {
                     let (c, m2) = moments(x, weights);
                     for (i, name) in ["a_moment", "b_moment", "c_moment"].iter().enumerate().take(D) {

@@ -60,11 +60,11 @@ fn bad_otm_input_names_the_field() {
     v["scheme"] = json!({"wcsph": {"sound_speed": 50.0, "locality": 1.5}});
     let e = error_of(v).to_string();
     assert!(e.contains("locality"), "{e}");
-    // What the scheme does not run yet: walls, two bodies; nor a locality beyond 10.
+    // A wall that cuts the body; two bodies; a locality beyond 10.
     let mut v = static_drop(0.02, 0.3);
-    v["boundaries"] = json!({"walls": [{"axis": 1, "position": -0.3, "fluid_side": "above"}]});
+    v["boundaries"] = json!({"walls": [{"axis": 1, "position": -0.1, "fluid_side": "above"}]});
     let e = error_of(v).to_string();
-    assert!(e.contains("otm"), "{e}");
+    assert!(e.contains("boundaries.walls[0].position") && e.contains("cuts the body"), "{e}");
     let mut v = static_drop(0.02, 0.3);
     let body = v["bodies"][0].clone();
     v["bodies"] = json!([body.clone(), body]);
@@ -185,4 +185,37 @@ fn a_periodic_channel_between_walls_reaches_the_poiseuille_profile() {
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let again = one.install(|| meniscus::run(&scene, &mut Quiet).expect("builds"));
     assert_eq!(again.probes, report.probes, "bit for bit on one thread");
+}
+
+/// The `pressure_gradient` probe fits the hydrostatic start of a block exactly: with
+/// `p = ρ g · (x − x_s)` on the points, its first sample is `∇p = ρ g` to round-off.
+#[test]
+fn the_pressure_gradient_probe_fits_a_hydrostatic_block() {
+    let v = json!({
+        "name": "otm_block",
+        "dimension": 2,
+        "dx": 0.1,
+        "kernel": {"kind": "cubic_spline", "h_over_dx": 1.5},
+        "fluid": {"density": 2.0, "viscosity": 0.5},
+        "body_force": [0.0, -10.0],
+        "bodies": [{"role": "fluid", "shape": {"rectangle": {"min": [0.0, 0.0], "max": [1.0, 1.0]}},
+                    "pressure": {"hydrostatic": {"surface_point": [0.0, 1.0]}}}],
+        "scheme": {"otm": {"sound_speed": 50.0}},
+        "time": {"end": 1e-4, "step": {"fixed": 1e-4}},
+        "probes": [{"pressure_gradient": {"center": [0.5, 0.5], "radius": 0.3}}],
+        "output": {"probe_every": 1}
+    });
+    let scene = Scene::from_json(&v.to_string()).expect("valid scene");
+    let report = meniscus::run(&scene, &mut Quiet).expect("builds");
+    let first = |q: &str| report.probes.get("pressure_gradient", q).expect("recorded")[0];
+    assert!(
+        (first("dp_dy") + 20.0).abs() < 1e-9 && first("dp_dx").abs() < 1e-9,
+        "{} {}",
+        first("dp_dx"),
+        first("dp_dy")
+    );
+    assert!(first("count") > 10.0);
+    let mut bad = v.clone();
+    bad["probes"] = json!([{"pressure_gradient": {"center": [0.5], "radius": 0.3}}]);
+    assert!(error_of(bad).to_string().contains("probes[0].pressure_gradient.center"));
 }

@@ -9,6 +9,7 @@
 pub mod capillarity;
 pub mod channel;
 pub mod elliptical_drop;
+pub mod hydrostatic;
 pub mod impact;
 pub mod poiseuille;
 pub mod rotating_square;
@@ -68,6 +69,7 @@ pub fn compute(
         ReferenceSpec::DropletImpact { diameter, speed } => {
             impact::compute(&impact::Params::new(diameter, speed, scene), probes)?
         }
+        ReferenceSpec::Hydrostatic {} => hydrostatic::compute(&hydrostatic::gravity(scene)?, probes)?,
         ReferenceSpec::SquareDrop { side, sigma, density } => {
             let dim = capillarity::dimension(scene)?;
             capillarity::compute(dim, &capillarity::Capillary::Square { side, sigma, density }, probes)?

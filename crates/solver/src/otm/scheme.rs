@@ -16,12 +16,12 @@
 
 use super::lme::LmeParams;
 use super::mesh::{Mesh, Point, disc, half_disc, rectangle};
-use super::step::{Body, Geometry, OtmParams, Period};
+use super::step::{Body, Geometry, OtmParams, Period, Plane};
 use crate::error::{Cause, SceneError};
 use crate::fields::{ColumnMut, ColumnRef, Field, Fields};
 use crate::kernel::{Kernel, Scaled};
 use crate::scene::lattice::{initial_pressure, initial_velocity};
-use crate::scene::{Scene, Scheme as SceneScheme, Shape};
+use crate::scene::{Scene, Scheme as SceneScheme, Shape, Side};
 use crate::scheme::{Adaptive, Composed, Scheme};
 use crate::stage::{Stage, StepContext};
 use crate::state::{State, Vector};
@@ -125,14 +125,16 @@ impl<const D: usize> Scheme<D> for Otm {
             support_tolerance: 1e-6,
         };
         let mut body = Body::new(&mesh, scene.dx, params, place.geometry);
-        // Nodal boundary conditions (validated: edges of a rectangle). No slip: the nodes on
-        // a wall are held at rest.
-        let on = |a: f64, b: f64| (a - b).abs() <= 1e-9 * scene.dx.max(b.abs());
+        // Walls (validated: the body on the fluid side): planes the nodes do not cross, those
+        // on a plane held there at rest (no slip). In 3D the plane is normal to the axis.
         for w in &scene.boundaries.walls {
-            body.fixed.extend((0..body.nodes.len()).filter(|&a| on(body.nodes[a][w.axis], w.position)));
+            let axis = if place.geometry == Geometry::Axisymmetric { 1 } else { w.axis };
+            let side = if w.fluid_side == Side::Above { 1.0 } else { -1.0 };
+            body.walls.push(Plane { axis, position: w.position, side });
         }
-        body.fixed.sort_unstable();
-        body.fixed.dedup();
+        for a in 0..body.nodes.len() {
+            body.held[a] = body.walls.iter().any(|w| w.touches(&body.nodes[a], scene.dx));
+        }
         if let Some(pd) = scene.boundaries.periodic.first() {
             let period = Period { axis: pd.axis, min: pd.min, length: pd.max - pd.min };
             body = body.with_period(period).map_err(|e| {

@@ -918,6 +918,16 @@ pub enum Probe {
         /// Its radius \[m\].
         radius: f64,
     },
+    /// The least-squares pressure gradient over the fluid particles within `radius` of
+    /// `center` (`p ≈ p̄ + ∇p · (x − x̄)`, each particle weighted by its volume):
+    /// `dp_dx`, `dp_dy` (and `dp_dz` in 3D) \[Pa/m\] (a resting drop's hydrostatic
+    /// gradient, −ρg), and their number `count`.
+    PressureGradient {
+        /// Centre of the ball (disc in 2D) \[m\].
+        center: Vec<f64>,
+        /// Its radius \[m\].
+        radius: f64,
+    },
     /// Ellipsoid semi-axes of the fluid (3D): `a_moment`, `b_moment`, `c_moment`
     /// (√(5⟨x_i²⟩) about the centroid along x, y, z: the semi-axes of the uniform ellipsoid
     /// with the same second moments) \[m\], and `x_centroid`, `y_centroid`, `z_centroid`.
@@ -1071,6 +1081,7 @@ impl Probe {
             Probe::EllipseAxes {} => "ellipse_axes",
             Probe::PressureAt { .. } => "pressure_at",
             Probe::MeanPressure { .. } => "mean_pressure",
+            Probe::PressureGradient { .. } => "pressure_gradient",
             Probe::EllipsoidAxes {} => "ellipsoid_axes",
             Probe::KineticEnergy {} => "kinetic_energy",
             Probe::Momentum {} => "momentum",

@@ -155,6 +155,10 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
             vector(&format!("probes[{i}].mean_pressure.center"), center, d)?;
             positive(&format!("probes[{i}].mean_pressure.radius"), *radius)?;
         }
+        if let Probe::PressureGradient { center, radius } = probe {
+            vector(&format!("probes[{i}].pressure_gradient.center"), center, d)?;
+            positive(&format!("probes[{i}].pressure_gradient.radius"), *radius)?;
+        }
         if let Probe::Spread { axis, position, layer } = probe {
             let key = format!("probes[{i}].spread");
             if *axis >= d {
@@ -375,40 +379,53 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
     validate_otm_boundaries(o, scene)
 }
 
-/// The otm scheme's nodal boundary conditions: a periodic axis and the no-slip walls are
-/// edges of a rectangle (its nodes there are merged across the period, or held at rest),
-/// and a periodic body has no free surface to carry surface tension.
+/// The otm scheme's nodal boundary conditions: a wall is a plane the body lies on the
+/// fluid side of (its nodes on the plane are held at rest, others once they reach it; in
+/// 3D, axisymmetric, a plane normal to z); a periodic axis is a rectangle's extent (its
+/// two edges merged), and a periodic body has no free surface to carry surface tension.
 fn validate_otm_boundaries(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
     let b = &scene.boundaries;
-    if b.walls.is_empty() && b.periodic.is_empty() {
+    // The body's extent on each axis.
+    let (lo, hi): (Vec<f64>, Vec<f64>) = match &scene.bodies[0].shape {
+        Shape::Rectangle { min, max } => (min.to_vec(), max.to_vec()),
+        Shape::Circle { center, radius } | Shape::Sphere { center, radius } => {
+            (center.iter().map(|c| c - radius).collect(), center.iter().map(|c| c + radius).collect())
+        }
+        _ => return Ok(()),
+    };
+    let tol = 1e-9 * scene.dx;
+    for (i, w) in b.walls.iter().enumerate() {
+        if scene.dimension == 3 && w.axis != 2 {
+            return Err(SceneError::new(
+                format!("boundaries.walls[{i}].axis"),
+                w.axis,
+                "must be 2 for the otm scheme in 3D (axisymmetric about z: a wall normal to z)",
+            ));
+        }
+        let inside = match w.fluid_side {
+            Side::Above => lo[w.axis] >= w.position - tol,
+            Side::Below => hi[w.axis] <= w.position + tol,
+        };
+        if !inside {
+            return Err(SceneError::new(
+                format!("boundaries.walls[{i}].position"),
+                w.position,
+                format!(
+                    "cuts the body ({} to {} m on axis {}): the otm scheme's body lies on the wall's fluid side",
+                    lo[w.axis], hi[w.axis], w.axis
+                ),
+            ));
+        }
+    }
+    if b.periodic.is_empty() {
         return Ok(());
     }
-    let Shape::Rectangle { min, max } = &scene.bodies[0].shape else {
-        let field = if b.periodic.is_empty() { "boundaries.walls" } else { "boundaries.periodic" };
+    if !matches!(scene.bodies[0].shape, Shape::Rectangle { .. }) {
         return Err(SceneError::new(
-            field,
+            "boundaries.periodic",
             "on a body that is not a rectangle",
-            "the otm scheme's walls and periodic axes are edges of a rectangular body",
+            "the otm scheme's periodic axis is a rectangle's extent",
         ));
-    };
-    let on = |a: f64, b: f64| (a - b).abs() <= 1e-9 * scene.dx.max(a.abs());
-    for (i, p) in b.periodic.iter().enumerate() {
-        if !(on(p.min, min[p.axis]) && on(p.max, max[p.axis])) {
-            return Err(SceneError::new(
-                format!("boundaries.periodic[{i}]"),
-                format!("[{}, {}] on axis {}", p.min, p.max, p.axis),
-                "must be the rectangle's extent on that axis for the otm scheme (its nodes on the two edges are merged)",
-            ));
-        }
-        // The support radius dx √(ln 10⁶ / γ) (`otm::lme::LmeParams::cutoff`).
-        let support = scene.dx * (1e6f64.ln() / o.locality).sqrt();
-        if p.max - p.min <= 2.0 * support {
-            return Err(SceneError::new(
-                format!("boundaries.periodic[{i}]"),
-                p.max - p.min,
-                "must exceed twice the otm shape functions' support (a node's nearest image must be unique)",
-            ));
-        }
     }
     if b.periodic.len() > 1 {
         return Err(SceneError::new(
@@ -417,25 +434,30 @@ fn validate_otm_boundaries(o: &OtmOptions, scene: &Scene) -> Result<(), SceneErr
             "the otm scheme takes one periodic axis",
         ));
     }
-    if !b.periodic.is_empty() && scene.fluid.surface_tension > 0.0 {
+    let on = |a: f64, b: f64| (a - b).abs() <= 1e-9 * scene.dx.max(a.abs());
+    let p = &b.periodic[0];
+    if !(on(p.min, lo[p.axis]) && on(p.max, hi[p.axis])) {
+        return Err(SceneError::new(
+            "boundaries.periodic[0]",
+            format!("[{}, {}] on axis {}", p.min, p.max, p.axis),
+            "must be the rectangle's extent on that axis for the otm scheme (its nodes on the two edges are merged)",
+        ));
+    }
+    // The support radius dx √(ln 10⁶ / γ) (`otm::lme::LmeParams::cutoff`).
+    let support = scene.dx * (1e6f64.ln() / o.locality).sqrt();
+    if p.max - p.min <= 2.0 * support {
+        return Err(SceneError::new(
+            "boundaries.periodic[0]",
+            p.max - p.min,
+            "must exceed twice the otm shape functions' support (a node's nearest image must be unique)",
+        ));
+    }
+    if scene.fluid.surface_tension > 0.0 {
         return Err(SceneError::new(
             "fluid.surface_tension",
             scene.fluid.surface_tension,
             "must be 0 for the otm scheme with a periodic axis (no closed free surface to carry it)",
         ));
-    }
-    for (i, w) in b.walls.iter().enumerate() {
-        let edge = match w.fluid_side {
-            Side::Above => min[w.axis],
-            Side::Below => max[w.axis],
-        };
-        if w.axis > 1 || !on(w.position, edge) {
-            return Err(SceneError::new(
-                format!("boundaries.walls[{i}].position"),
-                w.position,
-                "must lie on the rectangle's edge on the fluid's side for the otm scheme (its nodes there are held at rest: no slip)",
-            ));
-        }
     }
     Ok(())
 }
