@@ -85,19 +85,23 @@ fn positive(field: &'static str, value: f64) -> Result<(), MeshError> {
     }
 }
 
+/// K = round(R/h), the rings of a disc or half-disc of `radius` at spacing `h` \[m\] (at
+/// least one).
+fn rings(radius: f64, h: f64) -> Result<usize, MeshError> {
+    positive("radius", radius)?;
+    positive("spacing", h)?;
+    match (radius / h).round() as usize {
+        0 => {
+            Err(MeshError { field: "spacing", value: h, rule: "must be at most twice the radius (one ring)" })
+        }
+        k => Ok(k),
+    }
+}
+
 /// A disc of `radius` about `centre` with node spacing about `h` \[m\]: K = round(R/h)
 /// rings (at least one), ring k of radius kR/K with 6k nodes, the centre a node.
 pub fn disc(centre: Point, radius: f64, h: f64) -> Result<Mesh, MeshError> {
-    positive("radius", radius)?;
-    positive("spacing", h)?;
-    let rings = (radius / h).round() as usize;
-    if rings == 0 {
-        return Err(MeshError {
-            field: "spacing",
-            value: h,
-            rule: "must be at most twice the radius (one ring)",
-        });
-    }
+    let rings = rings(radius, h)?;
     let mut nodes = vec![centre];
     // first[k]: index of ring k's first node (ring 0 is the centre).
     let mut first = vec![0];
@@ -149,16 +153,7 @@ fn zip(triangles: &mut Vec<[usize; 3]>, inner: (usize, usize), outer: (usize, us
 /// its end nodes exactly on the axis. The boundary polygon starts with the free arc, from
 /// the bottom pole up to the top pole; the rest of it lies on the axis.
 pub fn half_disc(centre: Point, radius: f64, h: f64) -> Result<Mesh, MeshError> {
-    positive("radius", radius)?;
-    positive("spacing", h)?;
-    let rings = (radius / h).round() as usize;
-    if rings == 0 {
-        return Err(MeshError {
-            field: "spacing",
-            value: h,
-            rule: "must be at most twice the radius (one ring)",
-        });
-    }
+    let rings = rings(radius, h)?;
     let mut nodes = vec![centre];
     let mut first = vec![0];
     for k in 1..=rings {

@@ -667,6 +667,16 @@ mod tests {
         Body::new(&disc(Point::zeros(), 0.2, h).unwrap(), h, params, Geometry::Plane)
     }
 
+    /// Steps `b` at its stable step (CFL 0.3, viscous 0.125) to `end` \[s\].
+    fn run_to(b: &mut Body, end: f64) {
+        let mut t = 0.0;
+        while t < end {
+            let dt = b.stable_step(0.3, 0.125);
+            b.step(dt).unwrap();
+            t += dt;
+        }
+    }
+
     /// Without forces a body at rest stays at rest: no pressure, no motion, the volumes kept
     /// (to round-off: det ΔF = 1 ± 1e-14 per step).
     #[test]
@@ -720,12 +730,7 @@ mod tests {
     #[test]
     fn the_static_drop_settles_at_the_laplace_pressure() {
         let mut b = zhou_static(0.02);
-        let mut t = 0.0;
-        while t < 0.5 {
-            let dt = b.stable_step(0.3, 0.125);
-            b.step(dt).unwrap();
-            t += dt;
-        }
+        run_to(&mut b, 0.5);
         let p = b.mean_pressure();
         assert!((p / 5.0 - 1.0).abs() < 0.01, "mean pressure {p} Pa");
         assert!(b.kinetic_energy() < 1e-8, "{}", b.kinetic_energy());
@@ -746,12 +751,7 @@ mod tests {
         );
         let volume = b.area();
         assert!((volume / (4.0 / 3.0 * PI * 0.008) - 1.0).abs() < 0.01, "{volume}");
-        let mut t = 0.0;
-        while t < 0.3 {
-            let dt = b.stable_step(0.3, 0.125);
-            b.step(dt).unwrap();
-            t += dt;
-        }
+        run_to(&mut b, 0.3);
         let p = b.mean_pressure();
         assert!((p / 10.0 - 1.0).abs() < 0.01, "mean pressure {p} Pa");
         // Spurious currents of a few mm/s remain (3.6e-3 m/s at 0.3 s).
