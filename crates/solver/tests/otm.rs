@@ -37,6 +37,10 @@ fn the_static_drop_settles_at_the_laplace_pressure() {
     let last = *p.last().unwrap();
     assert!((last / 5.0 - 1.0).abs() < 0.01, "mean pressure {last} Pa");
     assert_eq!(report.summary.particles, 600, "one material point per triangle: 6 K² for K = 10 rings");
+    let mut three = static_drop(0.02, 1e-3);
+    three["scheme"]["otm"]["quadrature"] = json!("degree_two");
+    let scene3 = Scene::from_json(&three.to_string()).expect("valid scene");
+    assert_eq!(meniscus::run(&scene3, &mut Quiet).expect("builds").summary.particles, 1800);
     let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap();
     let again = one.install(|| meniscus::run(&scene, &mut Quiet).expect("builds"));
     assert_eq!(again.probes, report.probes, "bit for bit on one thread");
@@ -72,6 +76,11 @@ fn bad_otm_input_names_the_field() {
     let mut v = static_drop(0.02, 0.3);
     v["scheme"]["otm"]["locality"] = json!(12.0);
     assert!(error_of(v).to_string().contains("(0, 10]"));
+    // The material points per triangle: a rule it knows, or an error naming the options.
+    let mut v = static_drop(0.02, 0.3);
+    v["scheme"]["otm"]["quadrature"] = json!("gauss");
+    let e = error_of(v).to_string();
+    assert!(e.contains("gauss") && e.contains("degree_two"), "{e}");
     // An initial pressure that the equation of state turns into a negative density.
     let mut v = static_drop(0.02, 0.3);
     v["bodies"][0]["pressure"] =

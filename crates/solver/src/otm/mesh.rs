@@ -289,6 +289,23 @@ mod tests {
         }
     }
 
+    /// The degree-two rule: three points per triangle, inside it, a third of its area each,
+    /// their mean its centroid (so the total area and the first moments are the centroid
+    /// rule's).
+    #[test]
+    fn the_degree_two_points_split_each_triangle_in_three() {
+        let m = disc(Point::new(0.1, -0.3), 0.2, 0.05).unwrap();
+        let one = m.material_points();
+        let three = m.material_points_degree_two();
+        assert_eq!(three.len(), 3 * one.len());
+        for (t, (c, area)) in one.iter().enumerate() {
+            let part = &three[3 * t..3 * t + 3];
+            let mean = part.iter().map(|(x, _)| x).sum::<Point>() / 3.0;
+            assert!((mean - c).norm() < 1e-15);
+            assert!(part.iter().all(|(_, a)| (a * 3.0 - area).abs() < 1e-15));
+        }
+    }
+
     #[test]
     fn rectangles_are_grids() {
         let m = rectangle(Point::new(0.0, 0.0), Point::new(1.0, 0.5), 0.1).unwrap();

@@ -124,7 +124,10 @@ impl<const D: usize> Scheme<D> for Otm {
             lme: LmeParams { gamma: opts.locality, ..LmeParams::default() },
             support_tolerance: 1e-6,
         };
-        let mut body = Body::new(&mesh, scene.dx, params, place.geometry);
+        let mut body = match opts.quadrature {
+            Some(q) => Body::with_quadrature(&mesh, scene.dx, params, place.geometry, q),
+            None => Body::new(&mesh, scene.dx, params, place.geometry),
+        };
         // Walls (validated: the body on the fluid side): planes the nodes do not cross, those
         // on a plane held there at rest (no slip). In 3D the plane is normal to the axis.
         for w in &scene.boundaries.walls {

@@ -27,6 +27,7 @@
 use super::lme::{LmeError, LmeParams, shape_functions};
 use super::mesh::{Mesh, Point};
 use crate::error::Cause;
+use crate::scene::Quadrature;
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -300,9 +301,24 @@ impl Body {
     /// 20–30 % below the static drop's pressure, the nodes beside the poles drift, and the
     /// oscillating drop's poles fold (docs/notes/otm.md).
     pub fn new(mesh: &Mesh, h: f64, params: OtmParams, geometry: Geometry) -> Self {
-        let (points, area): (Vec<Point>, Vec<f64>) = match geometry {
-            Geometry::Plane => mesh.material_points().into_iter().unzip(),
-            Geometry::Axisymmetric => mesh.material_points_degree_two().into_iter().unzip(),
+        let quadrature = match geometry {
+            Geometry::Plane => Quadrature::Centroid,
+            Geometry::Axisymmetric => Quadrature::DegreeTwo,
+        };
+        Self::with_quadrature(mesh, h, params, geometry, quadrature)
+    }
+
+    /// [`Body::new`] with the material points of `quadrature` in each triangle.
+    pub fn with_quadrature(
+        mesh: &Mesh,
+        h: f64,
+        params: OtmParams,
+        geometry: Geometry,
+        quadrature: Quadrature,
+    ) -> Self {
+        let (points, area): (Vec<Point>, Vec<f64>) = match quadrature {
+            Quadrature::Centroid => mesh.material_points().into_iter().unzip(),
+            Quadrature::DegreeTwo => mesh.material_points_degree_two().into_iter().unzip(),
         };
         let np = points.len();
         let (volume, section, boundary) = match geometry {

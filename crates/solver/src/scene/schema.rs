@@ -394,9 +394,10 @@ pub enum Scheme {
     Otm(OtmOptions),
 }
 
-/// Options of the optimal-transportation meshfree scheme (see [`crate::otm`]): 2D, one
-/// fluid body (a circle or a rectangle) meshed at the scene's `dx`; the scene's `kernel`
-/// is used only by the probes' kernel-weighted averages.
+/// Options of the optimal-transportation meshfree scheme (see [`crate::otm`]): one fluid
+/// body meshed at the scene's `dx` (a circle or a rectangle in 2D, a sphere solved
+/// axisymmetric in 3D); the scene's `kernel` is used only by the probes' kernel-weighted
+/// averages.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct OtmOptions {
@@ -405,6 +406,21 @@ pub struct OtmOptions {
     /// Locality γ of the LME shape functions, `β = γ / dx²` (dimensionless; 1.5 if absent).
     #[serde(default = "default_locality")]
     pub locality: f64,
+    /// Material points per triangle (absent: `centroid` in 2D, `degree_two` in 3D, where
+    /// one point per triangle does not hold a uniform pressure next to the axis).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub quadrature: Option<Quadrature>,
+}
+
+/// Where an OTM body's material points sit in each triangle of its set-up mesh.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Quadrature {
+    /// One point at the centroid with the triangle's area (Zhou 2021 §2.1).
+    Centroid,
+    /// Three points at the barycentric (2/3, 1/6, 1/6) points, a third of the area each
+    /// (the degree-two rule).
+    DegreeTwo,
 }
 
 fn default_locality() -> f64 {
