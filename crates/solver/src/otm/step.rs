@@ -180,12 +180,15 @@ impl NodeGrid {
                 _ => (lo[i], (hi[i] - lo[i]).max(0.0)),
             };
             self.wraps[i] = period.is_some_and(|pd| pd.axis == i);
-            self.cells[i] = ((extent / r).floor() as usize).max(1);
             self.lo[i] = from;
-            self.width[i] = if self.wraps[i] { extent / self.cells[i] as f64 } else { r };
-            if !self.wraps[i] {
-                self.cells[i] = (extent / r).floor() as usize + 1;
-            }
+            // A period is cut into whole cells at least `r` wide; an open extent into cells
+            // exactly `r` wide, one more to hold its upper end.
+            (self.cells[i], self.width[i]) = if self.wraps[i] {
+                let n = ((extent / r).floor() as usize).max(1);
+                (n, extent / n as f64)
+            } else {
+                ((extent / r).floor() as usize + 1, r)
+            };
         }
         let total = self.cells[0] * self.cells[1];
         let mut cell_of = std::mem::take(&mut self.cell_of);
@@ -204,11 +207,14 @@ impl NodeGrid {
             self.start[c + 1] += self.start[c];
         }
         self.nodes.resize(nodes.len(), 0);
-        let mut next = self.start.clone();
+        // `start[c]` is the cursor of cell c while the nodes are placed (ending at cell c +
+        // 1's start), then shifted back by one cell: no second array.
         for (a, &c) in self.cell_of.iter().enumerate() {
-            self.nodes[next[c]] = a;
-            next[c] += 1;
+            self.nodes[self.start[c]] = a;
+            self.start[c] += 1;
         }
+        self.start.copy_within(0..total, 1);
+        self.start[0] = 0;
     }
 
     /// The cell of `x` (clamped into the grid).
