@@ -3,12 +3,14 @@
 //! mass, volume and stress, coupled by local max-entropy shape functions ([`lme`]); the
 //! bodies triangulated once at set-up ([`mesh`]); surface tension as the energy of the
 //! boundary nodes' polyline ([`surface`]); the step of a plane or axisymmetric body, with
-//! no-slip nodes and a periodic axis ([`step`]).
+//! no-slip nodes and a periodic axis ([`step`]), its nodal forces optionally integrated
+//! consistently ([`integration`]).
 //!
 //! As a scheme of the scene file ([`scheme`]): one body, a circle or a rectangle in 2D, a
 //! sphere solved axisymmetric in 3D; walls and a periodic axis on a rectangle's edges
 //! (issue #38 in progress; docs/notes/otm.md).
 
+pub mod integration;
 pub mod lme;
 pub mod mesh;
 pub mod scheme;

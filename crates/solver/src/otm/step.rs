@@ -7,7 +7,9 @@
 //! 3. lumped nodal masses `m_a = Σ_p m_p N_a(x_p)`;
 //! 4. nodal forces `f_a = −Σ_p V_p σ_p ∇N_a(x_p) + Σ_p m_p g N_a(x_p) + f_a^γ`, with
 //!    `σ_p = −p_p I + μ (∇v + ∇vᵀ)_p`, `∇v_p = Σ_a v_a ⊗ ∇N_a(x_p)` and the surface
-//!    tension of the boundary polyline ([`super::surface`]);
+//!    tension of the boundary polyline ([`super::surface`]); with [`Body::integration`]
+//!    other than `point`, the viscous stress's `∇N_a` (or both stresses') are the
+//!    consistent test gradients of [`super::integration`];
 //! 5. `v_a += Δt f_a / m_a`, `x_a += Δt v_a`;
 //! 6. the points follow the nodal map, `x_p = Σ_a N_a(x_p) x_a`; the volume update
 //!    `V_p ← det(ΔF_p) V_p` with `ΔF_p = Σ_a x_a ⊗ ∇N_a(x_p)` (new nodal positions, old
@@ -24,10 +26,11 @@
 //! `v_r = 0`, and the volume update is `S ← det(ΔF) S`, `V = 2π r S` (the hoop stretch
 //! `r_new / r_old` is in the new radius).
 
+use super::integration::{Correction, Moments, corrected};
 use super::lme::{LmeError, LmeParams, shape_functions};
 use super::mesh::{Mesh, Point};
 use crate::error::Cause;
-use crate::scene::Quadrature;
+use crate::scene::{Integration, Quadrature};
 use nalgebra::Matrix2;
 use rayon::prelude::*;
 use std::f64::consts::PI;
@@ -99,6 +102,8 @@ pub struct Body {
     pub walls: Vec<Plane>,
     /// Per node: held at rest on a wall.
     pub held: Vec<bool>,
+    /// How the nodal forces integrate over the points ([`super::integration`]).
+    pub integration: Integration,
     /// The nodes of point `p` are `support[p * stride..][..count[p]]`, with their positions
     /// (the nearest periodic image), shape function values and gradients alongside: rows
     /// of one stride, so that the points are solved in parallel.
@@ -118,6 +123,9 @@ pub struct Body {
     force: Vec<Point>,
     updated: Vec<(Point, f64)>,
     shift: Vec<Point>,
+    /// Scratch of the consistent integration: per node, the moments and the correction.
+    moments: Vec<Moments>,
+    correction: Vec<Correction>,
 }
 
 /// A wall: the plane `x[axis] = position`, the body on the side `side` (+1: above, −1:
@@ -356,6 +364,7 @@ impl Body {
             period: None,
             walls: Vec::new(),
             held: vec![false; mesh.nodes.len()],
+            integration: Integration::Point,
             stride: 0,
             count: Vec::new(),
             support: Vec::new(),
@@ -369,6 +378,8 @@ impl Body {
             force: vec![Point::zeros(); mesh.nodes.len()],
             updated: Vec::new(),
             shift: Vec::new(),
+            moments: Vec::new(),
+            correction: Vec::new(),
         }
     }
 
@@ -501,9 +512,37 @@ impl Body {
         l
     }
 
+    /// Per node, the correction of its test gradients ([`super::integration`]): none on
+    /// the boundary polyline and on the nodes held on a wall.
+    fn correct_test_gradients(&mut self) {
+        let mut moments = std::mem::take(&mut self.moments);
+        moments.clear();
+        moments.resize(self.nodes.len(), Moments::default());
+        for p in 0..self.points.len() {
+            for k in self.row(p) {
+                let d = self.points[p] - self.near[k];
+                moments[self.support[k]].add(self.volume[p], self.n[k], &self.grad_n[k], &d);
+            }
+        }
+        self.correction.clear();
+        self.correction.par_extend(moments.par_iter().map(Moments::correction));
+        self.moments = moments;
+        let plain = (Point::zeros(), Matrix2::zeros());
+        for &a in &self.boundary {
+            self.correction[a] = plain;
+        }
+        for (c, _) in self.correction.iter_mut().zip(&self.held).filter(|(_, held)| **held) {
+            *c = plain;
+        }
+    }
+
     /// One step of `dt` \[s\] (steps 1–6 of the module documentation).
     pub fn step(&mut self, dt: f64) -> Result<(), OtmError> {
         self.shape_functions()?;
+        let integration = self.integration;
+        if integration != Integration::Point {
+            self.correct_test_gradients();
+        }
         let OtmParams { viscosity: mu, gravity: g, sound_speed: c0, density: rho0, .. } = self.params;
         let axisymmetric = self.geometry == Geometry::Axisymmetric;
         // Step 4 per point, in parallel: each support entry's mass and force on its node.
@@ -516,7 +555,8 @@ impl Body {
         mass_to.par_chunks_mut(stride).zip(force_to.par_chunks_mut(stride)).enumerate().for_each(
             |(p, (mass_to, force_to))| {
                 let l = this.velocity_gradient(p);
-                let sigma = Matrix2::identity() * -this.pressure[p] + (l + l.transpose()) * mu;
+                let viscous = (l + l.transpose()) * mu;
+                let pressure = this.pressure[p];
                 // The hoop stress over the radius, σ_θθ / r \[Pa/m\] (axisymmetric).
                 let hoop = if axisymmetric {
                     let r = this.points[p][0];
@@ -527,7 +567,18 @@ impl Body {
                 };
                 for (i, k) in this.row(p).enumerate() {
                     mass_to[i] = this.mass[p] * this.n[k];
-                    let stress = sigma * this.grad_n[k] + Point::new(hoop * this.n[k], 0.0);
+                    let grad = &this.grad_n[k];
+                    let (a, d) = (this.support[k], this.points[p] - this.near[k]);
+                    let stress = match integration {
+                        Integration::Point => (Matrix2::identity() * -pressure + viscous) * grad,
+                        Integration::ConsistentViscous => {
+                            viscous * corrected(grad, this.n[k], &d, &this.correction[a]) - grad * pressure
+                        }
+                        Integration::Consistent => {
+                            let test = corrected(grad, this.n[k], &d, &this.correction[a]);
+                            viscous * test - test * pressure
+                        }
+                    } + Point::new(hoop * this.n[k], 0.0);
                     force_to[i] = -stress * this.volume[p] + g * (this.mass[p] * this.n[k]);
                 }
             },

@@ -410,6 +410,43 @@ pub struct OtmOptions {
     /// one point per triangle does not hold a uniform pressure next to the axis).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub quadrature: Option<Quadrature>,
+    /// Which stresses' nodal forces take the consistent integration of
+    /// [`crate::otm::integration`] (absent: `point`, Zhou's plain point sums).
+    #[serde(default, skip_serializing_if = "Integration::is_point")]
+    pub integration: Integration,
+}
+
+/// How the OTM nodal forces `−Σ_p V_p σ_p ∇N_a(x_p)` integrate over the material points
+/// ([`crate::otm::integration`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Integration {
+    /// The plain point sums (Zhou 2021, Li et al. 2010).
+    #[default]
+    Point,
+    /// The viscous stress's forces with the corrected test gradients, the pressure's plain:
+    /// long shear flows (the sheared arrangement of points among nodes otherwise loses the
+    /// quadrature's consistency and the viscous force with it).
+    ConsistentViscous,
+    /// Both stresses' forces with the corrected test gradients: a linear pressure field (a
+    /// hydrostatic body) gives exact nodal forces.
+    Consistent,
+}
+
+impl Integration {
+    /// True for the plain point sums (the default, left out of a written scene).
+    pub fn is_point(&self) -> bool {
+        *self == Integration::Point
+    }
+
+    /// The option's key in the scene file.
+    pub fn key(&self) -> &'static str {
+        match self {
+            Integration::Point => "point",
+            Integration::ConsistentViscous => "consistent_viscous",
+            Integration::Consistent => "consistent",
+        }
+    }
 }
 
 /// Where an OTM body's material points sit in each triangle of its set-up mesh.

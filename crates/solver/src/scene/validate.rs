@@ -366,6 +366,13 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
                 "must be 0 for the otm scheme in 3D (axisymmetric about z: gravity along z only)",
             ));
         }
+        if o.integration != Integration::Point {
+            return Err(SceneError::new(
+                "scheme.otm.integration",
+                o.integration.key(),
+                "must be `point` in 3D (the consistent integration is of the plane weak form, not the axisymmetric one)",
+            ));
+        }
     } else if !matches!(body.shape, Shape::Circle { .. } | Shape::Rectangle { .. }) {
         return Err(SceneError::new(
             "bodies[0].shape",
