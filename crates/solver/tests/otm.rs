@@ -154,91 +154,99 @@ fn a_3d_otm_scene_must_be_a_ball_about_z() {
     assert!(e.contains("scheme.otm.integration") && e.contains("consistent"), "{e}");
 }
 
-/// The profile L2 error \[-\] against the parabola `g y (D − y) / (2ν)` of a channel D = 1
-/// wide, ν = 0.25, g = 3 (Re = U D / ν = 4), after D²/ν: a shear strain of 6, with
-/// `integration` in the otm options.
-fn sheared_channel_error(integration: &str) -> f64 {
-    let (d, nu, g) = (1.0, 0.25, 3.0);
-    let v = json!({
-        "name": "otm_sheared_channel",
-        "dimension": 2,
-        "dx": 0.05,
-        "kernel": {"kind": "cubic_spline", "h_over_dx": 1.5},
-        "fluid": {"density": 1.0, "viscosity": nu},
-        "body_force": [g, 0.0],
-        "bodies": [{"role": "fluid", "shape": {"rectangle": {"min": [0.0, 0.0], "max": [0.5, d]}}}],
-        "boundaries": {
-            "periodic": [{"axis": 0, "min": 0.0, "max": 0.5}],
-            "walls": [{"axis": 1, "position": 0.0, "fluid_side": "above"},
-                      {"axis": 1, "position": d, "fluid_side": "below"}]
-        },
-        "scheme": {"otm": {"sound_speed": 15.0, "integration": integration}},
-        "time": {"end": d * d / nu, "step": {"adaptive": {"cfl": 0.3, "viscous": 0.125, "max": 0.01}}},
-        "probes": [{"velocity_profile": {"axis": 1, "component": 0, "range": [0.0, d]}}],
-        "output": {"probe_every": 100}
-    });
-    let scene = Scene::from_json(&v.to_string()).expect("valid scene");
-    let report = meniscus::run(&scene, &mut Quiet).expect("builds");
-    assert!(report.error.is_none(), "{:?}", report.error);
-    let (mut num, mut den) = (0.0, 0.0);
-    for k in 0..10 {
-        let y = *report.probes.get("velocity_profile", &format!("y_{k:03}")).unwrap().last().unwrap();
-        let u = *report.probes.get("velocity_profile", &format!("u_{k:03}")).unwrap().last().unwrap();
-        let exact = g * y * (d - y) / (2.0 * nu);
-        num += (u - exact).powi(2);
-        den += exact * exact;
-    }
-    (num / den).sqrt()
+/// A periodic channel `length` long and `d` wide between no-slip walls (the rectangle's
+/// edges: its nodes there held at rest, its two ends merged across the period), driven by a
+/// body force `g` \[m/s²\], ρ = 1, ν \[m²/s\], meshed at `dx`, with the `otm` options, run
+/// to D²/ν with the velocity profile and the momentum probed.
+struct Channel {
+    d: f64,
+    length: f64,
+    nu: f64,
+    g: f64,
+    dx: f64,
+    otm: Value,
 }
 
-/// Sheared by the flow, the rows of material points slide along the rows of nodes and the
-/// plain point sums lose their consistency: the channel ends several per cent off the
-/// parabola. With the viscous forces consistently integrated
-/// (`integration: consistent_viscous`, `otm::integration`) it ends within 1 %.
+impl Channel {
+    fn scene(&self) -> Scene {
+        let Channel { d, length, nu, g, dx, ref otm } = *self;
+        let v = json!({
+            "name": "otm_channel",
+            "dimension": 2,
+            "dx": dx,
+            "kernel": {"kind": "cubic_spline", "h_over_dx": 1.5},
+            "fluid": {"density": 1.0, "viscosity": nu},
+            "body_force": [g, 0.0],
+            "bodies": [{"role": "fluid", "shape": {"rectangle": {"min": [0.0, 0.0], "max": [length, d]}}}],
+            "boundaries": {
+                "periodic": [{"axis": 0, "min": 0.0, "max": length}],
+                "walls": [{"axis": 1, "position": 0.0, "fluid_side": "above"},
+                          {"axis": 1, "position": d, "fluid_side": "below"}]
+            },
+            "scheme": {"otm": otm},
+            "time": {"end": d * d / nu, "step": {"adaptive": {"cfl": 0.25, "viscous": 0.2, "max": 0.01}}},
+            "probes": [{"velocity_profile": {"axis": 1, "component": 0, "range": [0.0, d]}}, {"momentum": {}}],
+            "output": {"probe_every": 50}
+        });
+        Scene::from_json(&v.to_string()).expect("valid scene")
+    }
+
+    /// The final profile's L2 error \[-\] over the 10 bins against the parabola
+    /// `g y (D − y) / (2ν)`.
+    fn error(&self, report: &meniscus::run::RunReport) -> f64 {
+        let (mut num, mut den) = (0.0, 0.0);
+        for k in 0..10 {
+            let y = *report.probes.get("velocity_profile", &format!("y_{k:03}")).unwrap().last().unwrap();
+            let u = *report.probes.get("velocity_profile", &format!("u_{k:03}")).unwrap().last().unwrap();
+            let exact = self.g * y * (self.d - y) / (2.0 * self.nu);
+            num += (u - exact).powi(2);
+            den += exact * exact;
+        }
+        (num / den).sqrt()
+    }
+}
+
+/// Sheared by the flow (D = 1, ν = 0.25, g = 3: Re = U D / ν = 4, a shear strain of 6 by
+/// D²/ν), the rows of material points slide along the rows of nodes and the plain point
+/// sums lose their consistency: the channel ends several per cent off the parabola. With
+/// the viscous forces consistently integrated (`integration: consistent_viscous`,
+/// `otm::integration`) it ends within 1 %.
 #[test]
 fn consistent_integration_holds_a_sheared_channel_on_the_parabola() {
-    let point = sheared_channel_error("point");
-    let consistent = sheared_channel_error("consistent_viscous");
+    let error = |integration: &str| {
+        let channel = Channel {
+            d: 1.0,
+            length: 0.5,
+            nu: 0.25,
+            g: 3.0,
+            dx: 0.05,
+            otm: json!({"sound_speed": 15.0, "integration": integration}),
+        };
+        let report = meniscus::run(&channel.scene(), &mut Quiet).expect("builds");
+        assert!(report.error.is_none(), "{:?}", report.error);
+        channel.error(&report)
+    };
+    let (point, consistent) = (error("point"), error("consistent_viscous"));
     assert!(consistent < 0.01 && point > 3.0 * consistent, "point {point}, consistent_viscous {consistent}");
 }
 
-/// A periodic channel between no-slip walls (the rectangle's edges: its nodes there held at
-/// rest, its two ends merged across the period), driven by a body force: after D²/ν the
-/// profile is the parabola `g y (D − y) / (2ν)` within 2 % (L2 over the bins), the flow
-/// stays along x, and the run is the same on one thread and on two.
+/// A short, viscous periodic channel: after D²/ν the profile is the parabola within 2 %
+/// (L2 over the bins), the flow stays along x, and the run is the same on one thread and
+/// on two.
 #[test]
 fn a_periodic_channel_between_walls_reaches_the_poiseuille_profile() {
-    let (d, nu, g) = (0.2, 0.1, 1.0);
-    let v = json!({
-        "name": "otm_channel",
-        "dimension": 2,
-        "dx": 0.02,
-        "kernel": {"kind": "cubic_spline", "h_over_dx": 1.5},
-        "fluid": {"density": 1.0, "viscosity": nu},
-        "body_force": [g, 0.0],
-        "bodies": [{"role": "fluid", "shape": {"rectangle": {"min": [0.0, 0.0], "max": [0.2, d]}}}],
-        "boundaries": {
-            "periodic": [{"axis": 0, "min": 0.0, "max": 0.2}],
-            "walls": [{"axis": 1, "position": 0.0, "fluid_side": "above"},
-                      {"axis": 1, "position": d, "fluid_side": "below"}]
-        },
-        "scheme": {"otm": {"sound_speed": 0.5, "locality": 4.0}},
-        "time": {"end": d * d / nu, "step": {"adaptive": {"cfl": 0.25, "viscous": 0.2, "max": 0.01}}},
-        "probes": [{"velocity_profile": {"axis": 1, "component": 0, "range": [0.0, d]}}, {"momentum": {}}],
-        "output": {"probe_every": 50}
-    });
-    let scene = Scene::from_json(&v.to_string()).expect("valid scene");
+    let channel = Channel {
+        d: 0.2,
+        length: 0.2,
+        nu: 0.1,
+        g: 1.0,
+        dx: 0.02,
+        otm: json!({"sound_speed": 0.5, "locality": 4.0}),
+    };
+    let scene = channel.scene();
     let report = meniscus::run(&scene, &mut Quiet).expect("builds");
     assert!(report.error.is_none(), "{:?}", report.error);
-    let (mut num, mut den) = (0.0, 0.0);
-    for k in 0..10 {
-        let y = *report.probes.get("velocity_profile", &format!("y_{k:03}")).unwrap().last().unwrap();
-        let u = *report.probes.get("velocity_profile", &format!("u_{k:03}")).unwrap().last().unwrap();
-        let exact = g * y * (d - y) / (2.0 * nu);
-        num += (u - exact).powi(2);
-        den += exact * exact;
-    }
-    let l2 = (num / den).sqrt();
+    let l2 = channel.error(&report);
     assert!(l2 < 0.02, "profile L2 error {l2}");
     let py = report.probes.get("momentum", "py").unwrap().last().unwrap().abs();
     let px = report.probes.get("momentum", "px").unwrap().last().unwrap().abs();
