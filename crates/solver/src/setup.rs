@@ -44,6 +44,12 @@ pub fn fluid_state<const D: usize>(scene: &Scene, h: f64) -> State<D> {
     state_around(fluid_particles::<D>(scene), scene, h, 0, Default::default())
 }
 
+/// The shared state around fluid `particles` placed by a scheme of its own (OTM's material
+/// points): no open boundary.
+pub fn state_of<const D: usize>(particles: Particles<D>, scene: &Scene, h: f64) -> State<D> {
+    state_around(particles, scene, h, 0, Default::default())
+}
+
 /// The scene's bodies seeded, jittered and wrapped into periodic axes, ids in seeding order.
 fn fluid_particles<const D: usize>(scene: &Scene) -> Particles<D> {
     let mut seeds = seeding::seed_bodies::<D>(scene);

@@ -24,7 +24,7 @@ use crate::scene::lattice::{initial_pressure, initial_velocity};
 use crate::scene::{Scene, Scheme as SceneScheme, Shape, Side};
 use crate::scheme::{Adaptive, Composed, Scheme};
 use crate::stage::{Stage, StepContext};
-use crate::state::{State, Vector};
+use crate::state::{Particles, State, Vector};
 
 /// The OTM scheme's own data: its body (nodes and material points). No per-particle array
 /// is declared: the points' data lives in the body, in its own order (no reorder).
@@ -168,20 +168,22 @@ impl<const D: usize> Scheme<D> for Otm {
             body.pressure[p] = pressure;
             body.mass[p] = body.volume[p] * density;
         }
-        let mut state = crate::setup::fluid_state::<D>(scene, kernel.h);
         let n = body.points.len();
-        let p = &mut state.particles;
-        p.fluid = n;
-        p.id = (0..n as u32).collect();
-        p.x = body.points.iter().map(|x| place.lift::<D>(x)).collect();
-        p.u = body
-            .points
-            .iter()
-            .map(|x| place.lift_vector::<D>(&place.lower(&initial_velocity::<D>(field, &place.lift::<D>(x)))))
-            .collect();
-        p.p = body.pressure.clone();
-        p.div_r = vec![0.0; n];
-        p.free_surface = vec![false; n];
+        let particles = Particles::<D> {
+            fluid: n,
+            id: (0..n as u32).collect(),
+            x: body.points.iter().map(|x| place.lift::<D>(x)).collect(),
+            u: body
+                .points
+                .iter()
+                .map(|x| {
+                    place.lift_vector::<D>(&place.lower(&initial_velocity::<D>(field, &place.lift::<D>(x))))
+                })
+                .collect(),
+            p: body.pressure.clone(),
+            ..Default::default()
+        };
+        let mut state = crate::setup::state_of(particles, scene, kernel.h);
         // The probes weigh each point by its own volume; the mean stands for the rest.
         state.volumes = body.volume.clone();
         state.volume = body.area() / n as f64;
