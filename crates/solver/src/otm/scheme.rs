@@ -129,6 +129,7 @@ impl<const D: usize> Scheme<D> for Otm {
             None => Body::new(&mesh, scene.dx, params, place.geometry),
         };
         body.integration = opts.integration;
+        body.density = opts.density;
         // Walls (validated: the body on the fluid side): planes the nodes do not cross, those
         // on a plane held there at rest (no slip). In 3D the plane is normal to the axis.
         for w in &scene.boundaries.walls {

@@ -373,6 +373,13 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
                 "must be `point` in 3D (the consistent integration is of the plane weak form, not the axisymmetric one)",
             ));
         }
+        if o.density != Density::Material {
+            return Err(SceneError::new(
+                "scheme.otm.density",
+                o.density.key(),
+                "must be `material` in 3D (the nodal projection is not built for the axisymmetric rings)",
+            ));
+        }
     } else if !matches!(body.shape, Shape::Circle { .. } | Shape::Rectangle { .. }) {
         return Err(SceneError::new(
             "bodies[0].shape",
