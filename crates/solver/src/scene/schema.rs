@@ -431,7 +431,7 @@ pub enum Density {
     /// `ρ_p = Σ_a N_a ρ_a`, `V_p = m_p / ρ_p`. It removes the volume noise the nodes cannot
     /// move (two points per node in the plane), which otherwise grows in a long shear. For
     /// confined flows: on the drop on a plate (free surface, surface tension) a boundary
-    /// point left its nodes' hull within 1.6 s (docs/notes/otm.md).
+    /// point left its nodes' hull between 0.7 and 3.6 s (docs/notes/otm.md).
     Nodal,
 }
 
@@ -463,7 +463,8 @@ pub enum Integration {
     /// quadrature's consistency and the viscous force with it).
     ConsistentViscous,
     /// Both stresses' forces with the corrected test gradients: a linear pressure field (a
-    /// hydrostatic body) gives exact nodal forces.
+    /// hydrostatic body) gives exact nodal forces. The pressure–volume pair is then no
+    /// longer energy-consistent: a long Re = 40 channel diverged (docs/notes/otm.md).
     Consistent,
 }
 
