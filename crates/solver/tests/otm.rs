@@ -197,6 +197,13 @@ impl Channel {
         Scene::from_json(&v.to_string()).expect("valid scene")
     }
 
+    /// Runs the channel to its end and returns [`Channel::error`].
+    fn run_error(&self) -> f64 {
+        let report = meniscus::run(&self.scene(), &mut Quiet).expect("builds");
+        assert!(report.error.is_none(), "{:?}", report.error);
+        self.error(&report)
+    }
+
     /// The final profile's L2 error \[-\] over the 10 bins against the start-up series
     /// (Morris, Fox & Zhu 1997; the parabola `g y (D − y) / (2ν)` by D²/ν).
     fn error(&self, report: &meniscus::run::RunReport) -> f64 {
@@ -241,9 +248,7 @@ fn consistent_integration_holds_a_sheared_channel_on_the_parabola() {
             otm: json!({"sound_speed": 15.0, "integration": integration}),
             end: 1.0,
         };
-        let report = meniscus::run(&channel.scene(), &mut Quiet).expect("builds");
-        assert!(report.error.is_none(), "{:?}", report.error);
-        channel.error(&report)
+        channel.run_error()
     };
     let (point, consistent) = (error("point"), error("consistent_viscous"));
     assert!(consistent < 0.01 && point > 3.0 * consistent, "point {point}, consistent_viscous {consistent}");
@@ -265,9 +270,7 @@ fn a_nodal_density_keeps_a_long_shear_quiet() {
             otm: json!({"sound_speed": 15.0, "integration": "consistent_viscous", "density": density}),
             end: 0.3,
         };
-        let report = meniscus::run(&channel.scene(), &mut Quiet).expect("builds");
-        assert!(report.error.is_none(), "{:?}", report.error);
-        channel.error(&report)
+        channel.run_error()
     };
     let (material, nodal) = (error("material"), error("nodal"));
     assert!(nodal < 0.01 && material > 2.0 * nodal, "material {material}, nodal {nodal}");
