@@ -1,10 +1,11 @@
-//! The solver fingerprint of cached runs (`MENISCUS_SOLVER_FINGERPRINT`, read by
-//! `sweep::build_fingerprint`): SHA-256 of what a run's record depends on — the solver
-//! crate's sources and manifest, the workspace's `Cargo.lock` (the solver's dependencies)
-//! and the compiler's version — and of nothing in the harness. A change to the harness,
-//! its metrics or its reports re-evaluates the cached runs instead of rerunning them
-//! (the fingerprint of the whole executable did: an hour of the default tier per report
-//! change, issue #33); a change to the solver still reruns everything.
+//! The solver fingerprint ([`meniscus::SOLVER_FINGERPRINT`], from
+//! `MENISCUS_SOLVER_FINGERPRINT`): SHA-256 of what a run's result depends on — this
+//! crate's sources and manifest, the workspace's `Cargo.lock` (its dependencies) and the
+//! compiler's version — and of nothing in the harness or the command line. The harness
+//! keys its cached runs by it (a change to the harness, its metrics or its reports
+//! re-evaluates the cached runs instead of rerunning them: issue #33), and the `meniscus`
+//! binary prints it (`meniscus --version`), so that runs handed to it by the Slurm executor
+//! are known to come from the same solver.
 
 use sha2::{Digest, Sha256};
 use std::path::{Path, PathBuf};
@@ -32,6 +33,8 @@ fn main() {
     hash.update(&version);
     let hex: String = hash.finalize().iter().map(|b| format!("{b:02x}")).collect();
     println!("cargo:rustc-env=MENISCUS_SOLVER_FINGERPRINT={hex}");
+    let version = std::env::var("CARGO_PKG_VERSION").unwrap_or_default();
+    println!("cargo:rustc-env=MENISCUS_VERSION={version} (solver {hex})");
 }
 
 /// Every file under `dir`, recursively.

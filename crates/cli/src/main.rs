@@ -36,7 +36,7 @@ impl std::fmt::Display for Diverged {
 impl std::error::Error for Diverged {}
 
 #[derive(Parser, Debug)]
-#[command(name = "meniscus", version, about = "Particle-method CFD: run scenes, print reference solutions")]
+#[command(name = "meniscus", version = meniscus::VERSION, about = "Particle-method CFD: run scenes, print reference solutions")]
 struct Cli {
     #[command(subcommand)]
     command: Command,

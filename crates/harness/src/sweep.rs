@@ -102,11 +102,11 @@ pub fn spec(case: &Case, preset: &str, dx: f64) -> Result<RunSpec> {
 }
 
 /// The solver's fingerprint (SHA-256 of its sources, manifest, `Cargo.lock` and the
-/// compiler version; `build.rs`): any change of the solver's code invalidates cached runs,
+/// compiler version; [`meniscus::SOLVER_FINGERPRINT`]): any change of the solver's code invalidates cached runs,
 /// a change of the harness alone (metrics, checks, reports) does not — the records hold the
 /// runs' probes, from which the harness recomputes everything.
 pub fn build_fingerprint() -> &'static str {
-    env!("MENISCUS_SOLVER_FINGERPRINT")
+    meniscus::SOLVER_FINGERPRINT
 }
 
 /// The run of `preset` at `dx` from the start perturbed with jitter seed `seed`
