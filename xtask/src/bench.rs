@@ -34,6 +34,8 @@ pub struct Args {
     /// assertions, about 8 % slower) instead of re-running in a release build.
     #[arg(long)]
     dev_build: bool,
+    #[command(flatten)]
+    executor: crate::executor::Args,
 }
 
 /// Runs the study and prints the targets' verdicts; exits 1 when a target is missed (the
@@ -61,6 +63,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         threads: args.threads.max(1),
         progress: !args.no_progress,
         resume: args.resume,
+        slurm: args.executor.connect(&root)?,
     };
     let study = work_precision::run(&opts).context("the work-precision study could not run")?;
     let diverged = study.runs.iter().filter(|r| !r.ok()).count();

@@ -4,6 +4,7 @@
 //! for `deps`, in this package's library, which tests call).
 
 mod bench;
+mod executor;
 mod report;
 mod validate;
 

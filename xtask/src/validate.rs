@@ -39,6 +39,8 @@ pub struct Args {
     /// (in the HTML and summary.md). The exit code still depends on the checks only.
     #[arg(long, value_name = "DIR")]
     baseline: Option<PathBuf>,
+    #[command(flatten)]
+    executor: crate::executor::Args,
 }
 
 /// Runs the validation; the exit code is 0 only when every check passes.
@@ -46,6 +48,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
     let root = crate::workspace_root();
     let tier = crate::tier(args.quick, args.full);
     let (cases, run_cases, run_stability) = meniscus_harness::stability::split_cases(&args.cases, tier);
+    let slurm = args.executor.connect(&root)?;
     let opts = ValidateOptions {
         tier,
         cases,
@@ -56,6 +59,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
         jobs: args.jobs.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get())).max(1),
         progress: !args.no_progress,
         baseline: args.baseline,
+        slurm: slurm.clone(),
     };
     let start = Instant::now();
     let outcome = if run_cases {
@@ -90,6 +94,7 @@ pub fn run(args: Args) -> anyhow::Result<ExitCode> {
             force: opts.force,
             jobs: opts.jobs,
             progress: opts.progress,
+            slurm,
         })
         .context("the stability envelope could not run")?;
         let (passed, failed) = res.counts();

@@ -51,6 +51,12 @@ pub enum HarnessError {
         #[source]
         source: meniscus_reference::ReferenceError,
     },
+    /// The Slurm executor could not submit or follow its runs (see [`crate::slurm`]).
+    #[error("slurm: {message}")]
+    Slurm {
+        /// What went wrong, naming the option, command or task.
+        message: String,
+    },
     /// A plot could not be drawn.
     #[error("plot {file}: {message}")]
     Plot {

@@ -31,6 +31,7 @@ pub mod provenance;
 pub mod report;
 pub mod results;
 pub mod runner;
+pub mod slurm;
 pub mod snapshots;
 pub mod stability;
 pub mod sweep;

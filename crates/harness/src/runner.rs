@@ -21,6 +21,10 @@
 //!   the line the study makes of each finished job.
 //!
 //! A reused record's times (`summary.wall_s`, `cpu_s`) are those measured when it ran.
+//!
+//! With the Slurm executor ([`Runner::with_slurm`]) the runs not in the cache go to the
+//! cluster instead ([`crate::slurm`]) and their records come back into the same cache; a
+//! run whose task failed there ends [`Ran::Failed`] (counted, never cached).
 
 use crate::cache::{self, CachedProbes, RunRecord};
 use crate::error::{HarnessError, Result};
@@ -69,6 +73,12 @@ pub enum Ran {
         /// The panic's message.
         message: String,
     },
+    /// The executor could not run it: its Slurm task failed, timed out or was cancelled
+    /// (not cached: the next invocation submits it again).
+    Failed {
+        /// The executor's account (the task's state, exit code and log).
+        message: String,
+    },
 }
 
 impl Ran {
@@ -78,6 +88,7 @@ impl Ran {
         match self {
             Ran::Finished { record, .. } => record.status(),
             Ran::Panicked { message } => format!("diverged: the solver panicked: {message}"),
+            Ran::Failed { message } => format!("failed: {message}"),
         }
     }
 
@@ -85,7 +96,7 @@ impl Ran {
     pub fn record(&self) -> Option<&RunRecord> {
         match self {
             Ran::Finished { record, .. } => Some(record),
-            Ran::Panicked { .. } => None,
+            Ran::Panicked { .. } | Ran::Failed { .. } => None,
         }
     }
 
@@ -104,6 +115,8 @@ pub struct Tally {
     pub reused: usize,
     /// Jobs whose run panicked.
     pub panicked: usize,
+    /// Jobs the executor could not run (failed Slurm tasks).
+    pub failed: usize,
 }
 
 /// How the runner runs a scene: [`meniscus::run`] (tests put a panicking one in its place).
@@ -120,6 +133,7 @@ pub struct Runner {
     jobs: usize,
     tally: Mutex<Tally>,
     solve: Solve,
+    slurm: Option<std::sync::Arc<crate::slurm::Cluster>>,
 }
 
 impl Runner {
@@ -132,7 +146,14 @@ impl Runner {
             jobs: jobs.max(1),
             tally: Mutex::new(Tally::default()),
             solve: meniscus::run,
+            slurm: None,
         }
+    }
+
+    /// The same runner handing the runs it does not find in the cache to `cluster` (the
+    /// local executor when `None`).
+    pub fn with_slurm(self, cluster: Option<std::sync::Arc<crate::slurm::Cluster>>) -> Self {
+        Runner { slurm: cluster, ..self }
     }
 
     /// The progress display (for the studies' own lines).
@@ -174,6 +195,9 @@ impl Runner {
         jobs: &[(&Path, &Job)],
         finish: impl Fn(usize, Ran) -> Result<(T, String)> + Sync,
     ) -> Result<Vec<T>> {
+        if let Some(cluster) = &self.slurm {
+            return self.run_on_slurm(cluster, bar, jobs, finish);
+        }
         let before = self.tally();
         let units: Vec<u64> = jobs.iter().map(|(_, j)| bar_units(j.cost)).collect();
         let batch = bar.map(|name| self.progress.batch_bar(name, units.iter().sum(), jobs.len()));
@@ -257,6 +281,74 @@ impl Runner {
             }
         }
         items.into_iter().collect()
+    }
+
+    /// [`Runner::run_placed`] on a Slurm cluster: the cached records reused, the other jobs
+    /// run as job arrays; items in job order.
+    fn run_on_slurm<T>(
+        &self,
+        cluster: &crate::slurm::Cluster,
+        bar: Option<&str>,
+        jobs: &[(&Path, &Job)],
+        finish: impl Fn(usize, Ran) -> Result<(T, String)>,
+    ) -> Result<Vec<T>> {
+        let units: Vec<u64> = jobs.iter().map(|(_, j)| bar_units(j.cost)).collect();
+        let batch = bar.map(|name| self.progress.batch_bar(name, units.iter().sum(), jobs.len()));
+        let mut items: Vec<Option<T>> = jobs.iter().map(|_| None).collect();
+        let mut end = |i: usize, ran: Ran| -> Result<()> {
+            let (item, line) = finish(i, ran)?;
+            self.progress.println(&line);
+            if let Some(b) = &batch {
+                b.inc(units[i]);
+            }
+            items[i] = Some(item);
+            Ok(())
+        };
+        let mut pending = Vec::new();
+        for (i, (dir, job)) in jobs.iter().enumerate() {
+            let cached =
+                (!self.force).then(|| cache::load(&cache::record_path(dir, &job.spec.slug), &job.spec.hash));
+            match cached.flatten() {
+                Some(record) => {
+                    self.count(|t| t.reused += 1);
+                    end(i, Ran::Finished { record: Box::new(record), reused: true })?;
+                }
+                None => pending.push((i, &job.spec, job.threads)),
+            }
+        }
+        // Costliest first, as on this machine: an array's tasks start in index order.
+        pending.sort_by(|a, b| jobs[b.0].1.cost.total_cmp(&jobs[a.0].1.cost));
+        let show = |c: crate::slurm::Counts| {
+            if let Some(b) = &batch {
+                b.set_message(format!("slurm: {}", c.describe()));
+            }
+        };
+        cluster.run(&pending, self.force, &show, &mut |i, outcome| {
+            let (dir, job) = jobs[i];
+            let ran = match outcome {
+                crate::slurm::Outcome::Finished(record) => {
+                    cache::store(&cache::record_path(dir, &job.spec.slug), &record)?;
+                    self.count(|t| t.executed += 1);
+                    Ran::Finished { record, reused: false }
+                }
+                crate::slurm::Outcome::Failed(message) => {
+                    self.count(|t| {
+                        t.executed += 1;
+                        t.failed += 1;
+                    });
+                    Ran::Failed { message }
+                }
+            };
+            end(i, ran)
+        })?;
+        if let Some(b) = &batch {
+            let t = self.tally();
+            b.finish_with_message(format!(
+                "{} run on slurm, {} cached, {} failed",
+                t.executed, t.reused, t.failed
+            ));
+        }
+        Ok(items.into_iter().map(|i| i.expect("every job ended")).collect())
     }
 
     /// Reuses or runs one job (on `pool` when given).
@@ -434,14 +526,14 @@ mod tests {
                 out[1],
                 (1, "diverged: the solver panicked: the solver panicked on purpose".into(), false)
             );
-            assert_eq!(runner.tally(), Tally { executed: 2, reused: 0, panicked: 1 });
+            assert_eq!(runner.tally(), Tally { executed: 2, reused: 0, panicked: 1, failed: 0 });
         }
         assert!(cache::record_path(dir.path(), "isph-paper_dx0.1").is_file());
         assert!(!cache::record_path(dir.path(), "panics").exists(), "a panic is not cached");
         let runner = runner(false, 1);
         let out = runner.run(dir.path(), None, &jobs, finish).unwrap();
         assert_eq!(out[0], (0, "ok".to_string(), true), "reused");
-        assert_eq!(runner.tally(), Tally { executed: 1, reused: 1, panicked: 1 });
+        assert_eq!(runner.tally(), Tally { executed: 1, reused: 1, panicked: 1, failed: 0 });
         // An error (here the study's) starts no further job.
         let runner = Runner::new(Progress::silent(), true, 1);
         let failing = |i: usize, _: Ran| {

@@ -39,6 +39,8 @@ pub struct ValidateOptions {
     pub progress: bool,
     /// A previous `reports/` directory to compare the new results with.
     pub baseline: Option<PathBuf>,
+    /// Run what is not cached on this Slurm cluster instead of this machine.
+    pub slurm: Option<std::sync::Arc<crate::slurm::Cluster>>,
 }
 
 impl ValidateOptions {
@@ -55,6 +57,7 @@ impl ValidateOptions {
             jobs: 1,
             progress: false,
             baseline: None,
+            slurm: None,
         }
     }
 }
@@ -88,7 +91,8 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
     // Read the baseline before running anything: a wrong path fails at once, and a baseline
     // that is the output directory itself still holds the previous results.
     let baseline = opts.baseline.as_deref().map(|dir| Baseline::load(dir, Some(&known))).transpose()?;
-    let runner = Runner::new(Progress::new(opts.progress), opts.force, opts.jobs);
+    let runner =
+        Runner::new(Progress::new(opts.progress), opts.force, opts.jobs).with_slurm(opts.slurm.clone());
     let provenance = Provenance::collect(&opts.workspace);
     let mut outcome = Outcome { results: Vec::new(), executed: 0, reused: 0, comparison: None };
     // Every case's runs in one batch, so that the costliest of the tier start first.
@@ -122,7 +126,9 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
                 record.summary.wall_s,
                 if *reused { ", cached" } else { "" }
             ),
-            Ran::Panicked { .. } => format!("  {}/{} {}", spec.case, spec.slug, ran.status()),
+            Ran::Panicked { .. } | Ran::Failed { .. } => {
+                format!("  {}/{} {}", spec.case, spec.slug, ran.status())
+            }
         };
         Ok((ran, line))
     })?;

@@ -214,6 +214,8 @@ pub struct StabilityOptions {
     pub jobs: usize,
     /// Use the progress display (otherwise one plain line per run on stderr).
     pub progress: bool,
+    /// Run what is not cached on this Slurm cluster instead of this machine.
+    pub slurm: Option<std::sync::Arc<crate::slurm::Cluster>>,
 }
 
 /// How the cases named on the command line split between validation cases and the
@@ -347,11 +349,15 @@ impl Base {
     fn measure(&self, value: f64, slug: &str, ran: Ran) -> Result<Measured> {
         let record = match ran {
             Ran::Finished { record, .. } => record,
-            Ran::Panicked { message } => {
+            ran @ (Ran::Panicked { .. } | Ran::Failed { .. }) => {
+                let status = match ran {
+                    Ran::Panicked { message } => format!("panic: {message}"),
+                    other => other.status(),
+                };
                 let trial = Trial {
                     value,
                     slug: slug.to_string(),
-                    status: format!("panic: {message}"),
+                    status,
                     steps: 0,
                     t_final: 0.0,
                     wall_s: 0.0,
@@ -607,7 +613,8 @@ pub fn run(opts: &StabilityOptions) -> Result<StabilityResults> {
     let channel = Base::channel(cfg, &opts.validation_dir)?;
     let Kind::Channel { width, nu } = channel.kind else { unreachable!("the channel's kind") };
     let dir = opts.out.join(NAME);
-    let runner = Runner::new(Progress::new(opts.progress), opts.force, opts.jobs);
+    let runner =
+        Runner::new(Progress::new(opts.progress), opts.force, opts.jobs).with_slurm(opts.slurm.clone());
     let mut results = StabilityResults {
         case: NAME.into(),
         scheme: {
@@ -947,6 +954,7 @@ mod tests {
             force: false,
             jobs: 1,
             progress: false,
+            slurm: None,
         };
         let res = run(&opts).unwrap();
         let studies: Vec<(&str, &str)> =

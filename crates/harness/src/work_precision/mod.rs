@@ -72,6 +72,8 @@ pub struct Options {
     pub progress: bool,
     /// Reuse the cached runs of an earlier invocation (see the module documentation).
     pub resume: bool,
+    /// Run what is not cached on this Slurm cluster instead of this machine.
+    pub slurm: Option<std::sync::Arc<crate::slurm::Cluster>>,
 }
 
 /// The case the study runs.
@@ -128,7 +130,7 @@ pub fn run(opts: &Options) -> Result<Study> {
     let start = Instant::now();
     let total = design.runs.len() + channel_runs.len() + pipe_runs.len();
     let progress = if opts.progress { Progress::new(true) } else { Progress::silent() };
-    let runner = Runner::new(progress, !opts.resume, 1);
+    let runner = Runner::new(progress, !opts.resume, 1).with_slurm(opts.slurm.clone());
     // One line per run, and results.json rewritten with the run's row.
     let record = |i: usize,
                   id: &str,

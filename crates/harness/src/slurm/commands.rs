@@ -1,0 +1,175 @@
+//! Slurm's own commands (`sbatch`, `squeue`, `scontrol`, `sacct`, `sinfo`, `scancel`), run
+//! as child processes, and the parsers of their output.
+//!
+//! Hand-written on purpose: the one Rust crate for Slurm (`slurry` 0.1) drives the commands
+//! over SSH and parses only `squeue`; the commands themselves are Slurm's stable interface
+//! (`--parsable`, `-h -o`/`-O` formats, `scontrol -o`), and the few fields read here are
+//! parsed by the pure functions below, each tested on the commands' real output.
+
+use std::path::Path;
+use std::process::Command;
+
+/// A Slurm command's failure: the command line and what it printed.
+pub type CommandError = String;
+
+/// Runs `program args…`, returning its standard output; an error (start failure or
+/// non-zero exit) names the command and quotes its standard error.
+pub fn run(program: &str, args: &[&str]) -> Result<String, CommandError> {
+    let line = format!("{program} {}", args.join(" "));
+    let out =
+        Command::new(program).args(args).output().map_err(|e| format!("`{line}` could not start: {e}"))?;
+    if !out.status.success() {
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        return Err(format!("`{line}` failed ({}): {}", out.status, stderr.trim()));
+    }
+    Ok(String::from_utf8_lossy(&out.stdout).into_owned())
+}
+
+/// Whether `program` is an executable file in a directory of `PATH`.
+pub fn on_path(program: &str) -> bool {
+    std::env::var_os("PATH").is_some_and(|path| {
+        std::env::split_paths(&path).any(|dir| {
+            let file = dir.join(program);
+            file.is_file() && is_executable(&file)
+        })
+    })
+}
+
+#[cfg(unix)]
+fn is_executable(file: &Path) -> bool {
+    use std::os::unix::fs::PermissionsExt;
+    file.metadata().is_ok_and(|m| m.permissions().mode() & 0o111 != 0)
+}
+
+#[cfg(not(unix))]
+fn is_executable(file: &Path) -> bool {
+    file.is_file()
+}
+
+/// The partitions `sinfo -h -o %P` lists, the default one (marked `*`) first.
+pub fn parse_partitions(sinfo: &str) -> Vec<String> {
+    let mut names: Vec<(bool, String)> = sinfo
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .map(|l| (l.ends_with('*'), l.trim_end_matches('*').to_string()))
+        .collect();
+    names.sort_by_key(|(default, _)| !*default);
+    names.dedup_by(|a, b| a.1 == b.1);
+    names.into_iter().map(|(_, n)| n).collect()
+}
+
+/// The job id that `sbatch --parsable` printed (`<id>` or `<id>;<cluster>`).
+pub fn parse_job_id(sbatch: &str) -> Option<u64> {
+    sbatch.trim().split(';').next()?.trim().parse().ok()
+}
+
+/// A task's state as Slurm names it (`PENDING`, `RUNNING`, `COMPLETED`, `FAILED`,
+/// `CANCELLED`, `TIMEOUT`, …).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct TaskState {
+    /// The array task index.
+    pub task: usize,
+    /// Slurm's state name (`CANCELLED by 0` read as `CANCELLED`).
+    pub state: String,
+    /// `<exit code>:<signal>`, when the source gives it (`scontrol`, `sacct`).
+    pub exit_code: Option<String>,
+}
+
+impl TaskState {
+    /// Whether the task has ended (any state but pending, running, configuring, completing,
+    /// suspended or requeued).
+    pub fn ended(&self) -> bool {
+        !matches!(
+            self.state.as_str(),
+            "PENDING" | "RUNNING" | "CONFIGURING" | "COMPLETING" | "SUSPENDED" | "REQUEUED" | "RESIZING"
+        )
+    }
+}
+
+/// The tasks of `squeue -h -r --states=all -j <job> -o "%K %T"` (array task index, state);
+/// lines without a single task index (a pending range such as `3-9%2` is expanded by `-r`)
+/// are skipped.
+pub fn parse_squeue(squeue: &str) -> Vec<TaskState> {
+    squeue
+        .lines()
+        .filter_map(|l| {
+            let mut f = l.split_whitespace();
+            let task = f.next()?.parse().ok()?;
+            let state = f.next()?.to_string();
+            Some(TaskState { task, state, exit_code: None })
+        })
+        .collect()
+}
+
+/// The value of `key` in a line of `scontrol -o` (`Key=value` pairs split by spaces).
+pub fn field<'a>(line: &'a str, key: &str) -> Option<&'a str> {
+    line.split_whitespace().find_map(|kv| kv.strip_prefix(key).and_then(|v| v.strip_prefix('=')))
+}
+
+/// The tasks of `scontrol -o show job <job>` (one line per array task: `ArrayTaskId=`,
+/// `JobState=`, `ExitCode=`).
+pub fn parse_scontrol(scontrol: &str) -> Vec<TaskState> {
+    scontrol
+        .lines()
+        .filter_map(|l| {
+            let field = |key: &str| field(l, key);
+            Some(TaskState {
+                task: field("ArrayTaskId")?.parse().ok()?,
+                state: field("JobState")?.to_string(),
+                exit_code: field("ExitCode").map(str::to_string),
+            })
+        })
+        .collect()
+}
+
+/// The tasks of `sacct -n -P -X -j <job> -o JobID,State,ExitCode` (`<job>_<task>|STATE|0:0`).
+pub fn parse_sacct(sacct: &str) -> Vec<TaskState> {
+    sacct
+        .lines()
+        .filter_map(|l| {
+            let mut f = l.split('|');
+            let id = f.next()?;
+            let task = id.split_once('_')?.1.parse().ok()?;
+            let state = f.next()?.split_whitespace().next()?.to_string();
+            Some(TaskState { task, state, exit_code: f.next().map(str::to_string) })
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Outputs copied from Slurm 22.05 (Debian 12) on a one-node cluster.
+    #[test]
+    fn parses_the_commands_output() {
+        assert_eq!(parse_partitions("debug*\nlong\n"), ["debug", "long"]);
+        assert_eq!(parse_partitions("long\ndebug*\nlong\n"), ["debug", "long"]);
+        assert_eq!(parse_job_id("12\n"), Some(12));
+        assert_eq!(parse_job_id("12;meniscus\n"), Some(12));
+        assert_eq!(parse_job_id("sbatch: error"), None);
+        let partition = "PartitionName=remote AllowGroups=ALL Nodes=ghost[1-2] TotalCPUs=2 TotalNodes=2";
+        assert_eq!(field(partition, "Nodes"), Some("ghost[1-2]"));
+        assert_eq!(field(partition, "TotalNodes"), Some("2"));
+        assert_eq!(field(partition, "Missing"), None);
+        let q = parse_squeue("2 PENDING\n1 RUNNING\n3 COMPLETED\nN/A PENDING\n");
+        assert_eq!(q.len(), 3);
+        assert_eq!((q[0].task, q[0].state.as_str(), q[0].ended()), (2, "PENDING", false));
+        assert!(q[2].ended());
+        let s = parse_scontrol(
+            "JobId=4 ArrayJobId=1 ArrayTaskId=2 ArrayTaskThrottle=2 JobName=t.sh UserId=root(0) \
+             JobState=FAILED Reason=NonZeroExitCode Dependency=(null) ExitCode=7:0\n\
+             JobId=3 ArrayJobId=1 ArrayTaskId=1 JobState=CANCELLED Reason=None ExitCode=0:15\n",
+        );
+        assert_eq!(s.len(), 2);
+        assert_eq!((s[0].task, s[0].state.as_str(), s[0].exit_code.as_deref()), (2, "FAILED", Some("7:0")));
+        assert_eq!((s[1].state.as_str(), s[1].exit_code.as_deref()), ("CANCELLED", Some("0:15")));
+        let a = parse_sacct("7_0|COMPLETED|0:0\n7_1|CANCELLED by 0|0:15\n7_[2-3]|PENDING|0:0\n");
+        assert_eq!(a.len(), 2);
+        assert_eq!(
+            (a[1].task, a[1].state.as_str(), a[1].exit_code.as_deref()),
+            (1, "CANCELLED", Some("0:15"))
+        );
+    }
+}

@@ -1,0 +1,487 @@
+//! The Slurm executor: the runner's pending runs handed to a cluster as job arrays
+//! (`cargo xtask validate --executor slurm`, issue #40).
+//!
+//! [`Cluster::connect`] checks, before anything is submitted, that Slurm's commands are on
+//! `PATH`, that the partition exists, that the `meniscus` binary is of this solver build
+//! (its `--version` carries [`meniscus::SOLVER_FINGERPRINT`]) and that the spool directory
+//! is one the partition's nodes can read. [`Cluster::run`] then writes each run's scene to
+//! the [`spool`], submits one `sbatch --array` per thread count (task k runs one scene
+//! through `meniscus run`), follows the tasks with `squeue` (and `scontrol` / `sacct` for
+//! an ended task's exit code), and collects each finished run's outputs into the record the
+//! local executor would have written. A task that fails, times out or is cancelled is
+//! reported with its Slurm state and exit code and not collected; the next invocation
+//! submits it again, and only it. Ctrl-C cancels the submitted arrays (`scancel`).
+
+pub mod commands;
+pub mod spool;
+
+use crate::cache::RunRecord;
+use crate::error::{HarnessError, Result};
+use crate::sweep::RunSpec;
+use commands::{TaskState, run};
+use spool::Spool;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Options of the Slurm executor (the `--executor slurm` flags).
+#[derive(Debug, Clone)]
+pub struct SlurmOptions {
+    /// `sbatch --partition` (the cluster's default partition when `None`).
+    pub partition: Option<String>,
+    /// `sbatch --account`.
+    pub account: Option<String>,
+    /// `sbatch --time`, each task's time limit (`minutes`, `hh:mm:ss`, `days-hh`, …).
+    pub time_limit: Option<String>,
+    /// `sbatch --cpus-per-task`: the threads of each run (a job's own thread count, as the
+    /// work-precision study's, takes precedence).
+    pub cpus_per_task: usize,
+    /// The most tasks of an array running at once (`--array=0-N%max`).
+    pub max_tasks: Option<usize>,
+    /// The spool directory, on a file system shared with the compute nodes.
+    pub spool: PathBuf,
+    /// The `meniscus` binary the tasks run (it must be reachable from the nodes).
+    pub meniscus: PathBuf,
+    /// How often the tasks' states are read.
+    pub poll: Duration,
+}
+
+/// How long a task that Slurm reports ended may take to show its outputs (a shared file
+/// system's attribute cache) before it counts as failed.
+const GRACE: Duration = Duration::from_secs(30);
+
+/// File-system types that a cluster's nodes share (`/proc/self/mountinfo`'s type field).
+const SHARED_FILE_SYSTEMS: &[&str] = &[
+    "nfs",
+    "nfs4",
+    "lustre",
+    "gpfs",
+    "beegfs",
+    "ceph",
+    "fuse.ceph",
+    "cephfs",
+    "glusterfs",
+    "fuse.glusterfs",
+    "cifs",
+    "smb3",
+    "panfs",
+    "wekafs",
+    "pvfs2",
+    "orangefs",
+];
+
+/// A checked connection to a Slurm cluster (see the module documentation).
+#[derive(Debug)]
+pub struct Cluster {
+    opts: SlurmOptions,
+    partition: String,
+    spool: Spool,
+}
+
+/// How a run submitted to Slurm ended.
+#[derive(Debug)]
+pub enum Outcome {
+    /// Its task finished (completed or diverged): the record, as the local executor writes it.
+    Finished(Box<RunRecord>),
+    /// Its task failed, timed out or was cancelled, or its outputs could not be read: why.
+    Failed(String),
+}
+
+/// The tasks of the submitted arrays, by state (the progress display's).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Counts {
+    /// Waiting for resources.
+    pub pending: usize,
+    /// Running.
+    pub running: usize,
+    /// Finished and collected.
+    pub done: usize,
+    /// Failed, timed out or cancelled.
+    pub failed: usize,
+}
+
+impl Counts {
+    /// `3 pending, 2 running, 5 done, 1 failed`.
+    pub fn describe(&self) -> String {
+        format!(
+            "{} pending, {} running, {} done, {} failed",
+            self.pending, self.running, self.done, self.failed
+        )
+    }
+}
+
+/// Set by Ctrl-C while arrays are being followed.
+static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+fn slurm_error(message: impl Into<String>) -> HarnessError {
+    HarnessError::Slurm { message: message.into() }
+}
+
+impl Cluster {
+    /// Checks the cluster and the options (see the module documentation); nothing is
+    /// submitted.
+    pub fn connect(opts: SlurmOptions) -> Result<Cluster> {
+        for program in ["sbatch", "squeue", "scontrol", "scancel", "sinfo"] {
+            if !commands::on_path(program) {
+                return Err(slurm_error(format!(
+                    "--executor slurm: `{program}` is not on PATH: run on a node with Slurm's commands \
+                     (a login node) or add their directory to PATH"
+                )));
+            }
+        }
+        if opts.cpus_per_task == 0 {
+            return Err(slurm_error("--cpus-per-task: 0: must be at least 1"));
+        }
+        if opts.max_tasks == Some(0) {
+            return Err(slurm_error("--max-tasks: 0: must be at least 1"));
+        }
+        let partitions = commands::parse_partitions(&run("sinfo", &["-h", "-o", "%P"]).map_err(slurm_error)?);
+        let partition = match &opts.partition {
+            Some(p) if partitions.contains(p) => p.clone(),
+            Some(p) => {
+                return Err(slurm_error(format!(
+                    "--partition: `{p}` is not a partition of this cluster (sinfo lists: {})",
+                    partitions.join(", ")
+                )));
+            }
+            None => partitions.first().cloned().ok_or_else(|| slurm_error("sinfo lists no partition"))?,
+        };
+        check_binary(&opts.meniscus)?;
+        crate::io::create_dir(&opts.spool)?;
+        let spool_path = opts
+            .spool
+            .canonicalize()
+            .map_err(|source| HarnessError::Io { path: opts.spool.clone(), source })?;
+        check_shared(&spool_path, &partition)?;
+        Ok(Cluster { spool: Spool::new(spool_path), opts, partition })
+    }
+
+    /// The spool directory.
+    pub fn spool(&self) -> &Spool {
+        &self.spool
+    }
+
+    /// Runs `runs` (`(key, spec, threads)`; `threads` `None`: `--cpus-per-task`): each
+    /// finished in the spool already (unless `rerun`) is collected at once, the others are
+    /// submitted; `report(key, outcome)` is called as each ends, `progress` after each look
+    /// at the queue. Returns once every run ended; an interruption (Ctrl-C) cancels the
+    /// arrays and is an error.
+    pub fn run(
+        &self,
+        runs: &[(usize, &RunSpec, Option<usize>)],
+        rerun: bool,
+        progress: &dyn Fn(Counts),
+        report: &mut dyn FnMut(usize, Outcome) -> Result<()>,
+    ) -> Result<()> {
+        let mut counts = Counts::default();
+        // Arrays to submit: threads → runs.
+        let mut groups: BTreeMap<usize, Vec<(usize, &RunSpec)>> = BTreeMap::new();
+        for &(key, spec, threads) in runs {
+            if !rerun && self.spool.finished(spec) {
+                report(key, self.collect(spec))?;
+                counts.done += 1;
+                continue;
+            }
+            self.spool.prepare(spec, rerun)?;
+            groups.entry(threads.unwrap_or(self.opts.cpus_per_task)).or_default().push((key, spec));
+        }
+        if groups.is_empty() {
+            return Ok(());
+        }
+        install_interrupt_handler();
+        let mut arrays = Vec::new();
+        for (threads, tasks) in groups {
+            arrays.push(self.submit(threads, tasks)?);
+        }
+        loop {
+            if INTERRUPTED.swap(false, Ordering::SeqCst) {
+                let ids: Vec<String> = arrays.iter().map(|a| a.id.to_string()).collect();
+                let cancelled = run("scancel", &ids.iter().map(String::as_str).collect::<Vec<_>>());
+                return Err(slurm_error(format!(
+                    "interrupted: Slurm job(s) {} {}; runs that finished are kept, run the command \
+                     again to submit the others",
+                    ids.join(", "),
+                    match cancelled {
+                        Ok(_) => "cancelled".to_string(),
+                        Err(e) => format!("not cancelled: {e}"),
+                    }
+                )));
+            }
+            let (mut pending, mut running) = (0, 0);
+            for array in &mut arrays {
+                let (p, r) = array.poll(self, &mut counts, report)?;
+                (pending, running) = (pending + p, running + r);
+            }
+            progress(Counts { pending, running, ..counts });
+            if arrays.iter().all(|a| a.tasks.iter().all(|t| t.ended)) {
+                return Ok(());
+            }
+            std::thread::sleep(self.opts.poll);
+        }
+    }
+
+    /// The record of a finished run, or why it cannot be read.
+    fn collect(&self, spec: &RunSpec) -> Outcome {
+        match self.spool.collect(spec) {
+            Ok(record) => Outcome::Finished(Box::new(record)),
+            Err(e) => Outcome::Failed(format!("its outputs could not be read: {e}")),
+        }
+    }
+
+    /// Submits one array of `tasks`, each run on `threads` threads.
+    fn submit<'a>(&self, threads: usize, tasks: Vec<(usize, &'a RunSpec)>) -> Result<Array<'a>> {
+        let stamp =
+            std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
+        let name = format!("{stamp}-{}-t{threads}", std::process::id());
+        let dirs: Vec<PathBuf> = tasks.iter().map(|(_, spec)| self.spool.run_dir(spec)).collect();
+        let dir = self.spool.write_array(&name, &dirs, &self.opts.meniscus, threads)?;
+        let mut range = format!("0-{}", tasks.len() - 1);
+        if let Some(max) = self.opts.max_tasks {
+            range.push_str(&format!("%{max}"));
+        }
+        let log = dir.join("task_%a.log");
+        let mut args = vec![
+            "--parsable".to_string(),
+            format!("--array={range}"),
+            "--job-name=meniscus".to_string(),
+            format!("--partition={}", self.partition),
+            format!("--cpus-per-task={threads}"),
+            format!("--output={}", log.display()),
+        ];
+        if let Some(account) = &self.opts.account {
+            args.push(format!("--account={account}"));
+        }
+        if let Some(time) = &self.opts.time_limit {
+            args.push(format!("--time={time}"));
+        }
+        args.push(dir.join("run.sh").display().to_string());
+        let out = run("sbatch", &args.iter().map(String::as_str).collect::<Vec<_>>()).map_err(slurm_error)?;
+        let id = commands::parse_job_id(&out)
+            .ok_or_else(|| slurm_error(format!("sbatch printed no job id: `{}`", out.trim())))?;
+        crate::io::write_atomic(&dir.join("job_id"), format!("{id}\n").as_bytes())?;
+        let tasks =
+            tasks.into_iter().map(|(key, spec)| Task { key, spec, ended: false, since: None }).collect();
+        Ok(Array { id, dir, tasks })
+    }
+}
+
+/// One submitted array and its tasks (task k is `tasks[k]`).
+struct Array<'a> {
+    id: u64,
+    dir: PathBuf,
+    tasks: Vec<Task<'a>>,
+}
+
+/// A task of an array.
+struct Task<'a> {
+    key: usize,
+    spec: &'a RunSpec,
+    /// Reported (finished or failed).
+    ended: bool,
+    /// When Slurm was first seen to have ended it without its outputs (the grace period).
+    since: Option<Instant>,
+}
+
+impl Array<'_> {
+    /// Reads the array's task states and reports the tasks that ended (counted in
+    /// `counts`); returns how many are pending and how many running.
+    fn poll(
+        &mut self,
+        cluster: &Cluster,
+        counts: &mut Counts,
+        report: &mut dyn FnMut(usize, Outcome) -> Result<()>,
+    ) -> Result<(usize, usize)> {
+        let (mut pending, mut running) = (0, 0);
+        let id = self.id.to_string();
+        // A failed look at the queue is retried at the next poll (the controller may be busy).
+        let queue = run("squeue", &["-h", "-r", "--states=all", "-j", &id, "-o", "%K %T"])
+            .map(|out| commands::parse_squeue(&out))
+            .unwrap_or_default();
+        let state: BTreeMap<usize, TaskState> = queue.into_iter().map(|s| (s.task, s)).collect();
+        for k in 0..self.tasks.len() {
+            let task = &mut self.tasks[k];
+            if task.ended {
+                continue;
+            }
+            let outcome = if cluster.spool.finished(task.spec) {
+                Some(cluster.collect(task.spec))
+            } else {
+                match state.get(&k) {
+                    Some(s) if !s.ended() => {
+                        if s.state == "PENDING" {
+                            pending += 1;
+                        } else {
+                            running += 1;
+                        }
+                        None
+                    }
+                    // Failed, cancelled, timed out: the script moves the outputs into place
+                    // only when the run ended, so there are none to wait for.
+                    Some(s) if s.state != "COMPLETED" => Some(Outcome::Failed(self.failure(k, Some(s)))),
+                    // Completed without outputs yet, or gone from the queue: give the shared
+                    // file system its grace, then report it.
+                    _ => {
+                        let since = *task.since.get_or_insert_with(Instant::now);
+                        if since.elapsed() < GRACE {
+                            running += 1;
+                            None
+                        } else {
+                            Some(Outcome::Failed(self.failure(k, state.get(&k))))
+                        }
+                    }
+                }
+            };
+            if let Some(outcome) = outcome {
+                let task = &mut self.tasks[k];
+                task.ended = true;
+                match &outcome {
+                    Outcome::Finished(_) => counts.done += 1,
+                    Outcome::Failed(_) => counts.failed += 1,
+                }
+                report(task.key, outcome)?;
+            }
+        }
+        Ok((pending, running))
+    }
+
+    /// Why task `k` ended without outputs: its Slurm state and exit code (from `scontrol`,
+    /// else `sacct`, else the queue's last word) and its log.
+    fn failure(&self, k: usize, queued: Option<&TaskState>) -> String {
+        let id = self.id.to_string();
+        let detail = run("scontrol", &["-o", "show", "job", &id])
+            .map(|out| commands::parse_scontrol(&out))
+            .ok()
+            .and_then(|v| v.into_iter().find(|s| s.task == k))
+            .or_else(|| {
+                run("sacct", &["-n", "-P", "-X", "-j", &id, "-o", "JobID,State,ExitCode"])
+                    .map(|out| commands::parse_sacct(&out))
+                    .ok()
+                    .and_then(|v| v.into_iter().find(|s| s.task == k))
+            })
+            .or_else(|| queued.cloned());
+        let log = self.dir.join(format!("task_{k}.log"));
+        match detail {
+            Some(s) => format!(
+                "Slurm task {}_{k}: {}, exit code {} (log: {})",
+                self.id,
+                s.state,
+                s.exit_code.as_deref().unwrap_or("unknown"),
+                log.display()
+            ),
+            None => format!(
+                "Slurm task {}_{k} left the queue without its outputs (log: {})",
+                self.id,
+                log.display()
+            ),
+        }
+    }
+}
+
+/// Ctrl-C sets [`INTERRUPTED`] (installed once per process).
+fn install_interrupt_handler() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        // A handler that cannot be installed leaves Ctrl-C to end the process, the arrays
+        // running on (the next invocation collects what they finish).
+        let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
+    });
+}
+
+/// The `meniscus` binary exists and is of this solver build.
+fn check_binary(meniscus: &Path) -> Result<()> {
+    if !meniscus.is_file() {
+        return Err(slurm_error(format!(
+            "--meniscus: `{}` does not exist: build it with `cargo build -p meniscus-cli` (or name the \
+             binary with --meniscus)",
+            meniscus.display()
+        )));
+    }
+    let program = meniscus.display().to_string();
+    let version = run(&program, &["--version"]).map_err(slurm_error)?;
+    if !version.contains(meniscus::SOLVER_FINGERPRINT) {
+        return Err(slurm_error(format!(
+            "--meniscus: `{program}` is another build of the solver (`{}`; this harness's is {}): \
+             rebuild it with `cargo build -p meniscus-cli`",
+            version.lines().next().unwrap_or_default().trim(),
+            meniscus::SOLVER_FINGERPRINT
+        )));
+    }
+    Ok(())
+}
+
+/// The spool is readable from the partition's nodes: they are all this host, or it lies
+/// on a shared file system ([`SHARED_FILE_SYSTEMS`]).
+fn check_shared(spool: &Path, partition: &str) -> Result<()> {
+    let line = run("scontrol", &["-o", "show", "partition", partition]).map_err(slurm_error)?;
+    let list = commands::field(&line, "Nodes").unwrap_or_default();
+    let nodes: Vec<String> = run("scontrol", &["show", "hostnames", list])
+        .map_err(slurm_error)?
+        .lines()
+        .map(|l| l.trim().to_string())
+        .filter(|l| !l.is_empty())
+        .collect();
+    let here = hostname();
+    let short = |h: &str| h.split('.').next().unwrap_or(h).to_string();
+    if !nodes.is_empty() && here.as_deref().is_some_and(|h| nodes.iter().all(|n| short(n) == short(h))) {
+        return Ok(());
+    }
+    let mounts = std::fs::read_to_string("/proc/self/mountinfo").unwrap_or_default();
+    let fs = file_system(&mounts, spool).unwrap_or_else(|| "unknown".to_string());
+    if SHARED_FILE_SYSTEMS.contains(&fs.as_str()) {
+        return Ok(());
+    }
+    Err(slurm_error(format!(
+        "--spool: `{}` is on a node-local file system (`{fs}`): the nodes of partition `{partition}` \
+         ({}) cannot read it; put the spool on a shared file system ({})",
+        spool.display(),
+        nodes.join(", "),
+        SHARED_FILE_SYSTEMS.join(", ")
+    )))
+}
+
+/// This host's name (`/proc/sys/kernel/hostname`, else `$HOSTNAME`).
+fn hostname() -> Option<String> {
+    std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .ok()
+        .or_else(|| std::env::var("HOSTNAME").ok())
+        .map(|h| h.trim().to_string())
+        .filter(|h| !h.is_empty())
+}
+
+/// The type of the file system holding `path`, from `/proc/self/mountinfo` text: the
+/// mount with the longest mount point that is a prefix of `path`.
+fn file_system(mountinfo: &str, path: &Path) -> Option<String> {
+    mountinfo
+        .lines()
+        .filter_map(|l| {
+            let (left, right) = l.split_once(" - ")?;
+            let point = left.split_whitespace().nth(4)?.replace("\\040", " ");
+            let fs = right.split_whitespace().next()?;
+            path.starts_with(&point).then(|| (point.len(), fs.to_string()))
+        })
+        .max_by_key(|(len, _)| *len)
+        .map(|(_, fs)| fs)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_spools_file_system_is_its_longest_mount() {
+        let mounts = "22 1 254:0 / / rw,relatime - ext4 /dev/vda rw\n\
+                      30 22 0:40 / /home rw - nfs4 server:/home rw\n\
+                      31 22 0:41 / /home/x\\040y rw - tmpfs tmpfs rw\n";
+        assert_eq!(file_system(mounts, Path::new("/home/me/spool")).as_deref(), Some("nfs4"));
+        assert_eq!(file_system(mounts, Path::new("/home/x y/spool")).as_deref(), Some("tmpfs"));
+        assert_eq!(file_system(mounts, Path::new("/tmp/spool")).as_deref(), Some("ext4"));
+        assert_eq!(file_system("", Path::new("/tmp")), None);
+    }
+
+    #[test]
+    fn counts_read_as_a_line() {
+        let c = Counts { pending: 3, running: 2, done: 5, failed: 1 };
+        assert_eq!(c.describe(), "3 pending, 2 running, 5 done, 1 failed");
+    }
+}

@@ -1,0 +1,51 @@
+#!/usr/bin/env bash
+# Starts a one-node Slurm cluster on this machine (MUNGE, slurmctld and slurmd, with a
+# configuration made for the test, everything under a scratch directory) and runs the
+# Slurm executor's tests against it (crates/harness/tests/slurm.rs, ignored by a plain
+# `cargo test`). Needs root (the daemons run as root) and Debian's `slurm-wlm` and `munge`
+# packages (`.ci/run` installs them). Fails, saying why, when the cluster cannot start:
+# it never skips. Usage: tools/slurm-test/run.sh (from anywhere in the workspace).
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+
+fail() { echo "slurm-test: $*" >&2; exit 1; }
+[ "$(id -u)" -eq 0 ] || fail "needs root to start munged, slurmctld and slurmd (running as $(id -un))"
+for program in munged slurmctld slurmd sbatch squeue scontrol scancel sinfo; do
+  command -v "$program" >/dev/null || fail "\`$program\` is not installed (apt-get install slurm-wlm munge)"
+done
+
+dir=$(mktemp -d /tmp/meniscus-slurm.XXXXXX)
+cleanup() {
+  for pid in "$dir"/*.pid "$dir"/munge/munged.pid; do
+    [ -f "$pid" ] && kill "$(cat "$pid")" 2>/dev/null || true
+  done
+  rm -rf "$dir"
+}
+trap cleanup EXIT
+mkdir -p "$dir"/{state,spool,log,munge}
+chmod 700 "$dir/munge"
+head -c 1024 /dev/urandom > "$dir/munge/munge.key"
+chmod 400 "$dir/munge/munge.key"
+socket="$dir/munge/munge.socket"
+munged --force --key-file="$dir/munge/munge.key" --socket="$socket" \
+  --log-file="$dir/munge/munged.log" --pid-file="$dir/munge/munged.pid" \
+  --seed-file="$dir/munge/munged.seed" || fail "munged did not start: $(cat "$dir/munge/munged.log" 2>/dev/null)"
+
+host=$(hostname -s)
+export SLURM_CONF="$dir/slurm.conf"
+sed -e "s|@DIR@|$dir|g" -e "s|@HOST@|$host|g" -e "s|@CPUS@|$(nproc)|g" -e "s|@SOCKET@|$socket|g" \
+  tools/slurm-test/slurm.conf > "$SLURM_CONF"
+slurmctld -f "$SLURM_CONF" || fail "slurmctld did not start: $(tail -n 5 "$dir/log/slurmctld.log" 2>/dev/null)"
+slurmd -f "$SLURM_CONF" || fail "slurmd did not start: $(tail -n 5 "$dir/log/slurmd.log" 2>/dev/null)"
+for _ in $(seq 1 30); do
+  state=$(sinfo -h -p debug -o %t 2>/dev/null || true)
+  [ "$state" = "idle" ] && break
+  sleep 1
+done
+[ "$state" = "idle" ] || fail "the node did not come up (state \`$state\`): $(tail -n 5 "$dir/log/slurmd.log" "$dir/log/slurmctld.log")"
+echo "slurm-test: one-node cluster up on $host ($(sinfo --version))"
+
+# The tasks run this build's meniscus binary (the tests check its solver fingerprint).
+cargo build --quiet -p meniscus-cli
+MENISCUS_BIN="$(pwd)/target/debug/meniscus" \
+  cargo test -p meniscus-harness --test slurm -- --ignored --test-threads=1
