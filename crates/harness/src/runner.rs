@@ -383,24 +383,10 @@ impl Runner {
         bar.finish();
         match run {
             Ok(Ok(report)) => {
-                let record = RunRecord {
-                    completed: true,
-                    slug: spec.slug.clone(),
-                    scheme: spec.scheme.clone(),
-                    preset: spec.preset.clone(),
-                    dx: spec.dx,
-                    scene_hash: spec.hash.clone(),
-                    scene: spec.scene_json.clone(),
-                    summary: report.summary,
-                    probes: CachedProbes::from(report.probes),
-                    snapshots: report
-                        .snapshots
-                        .iter()
-                        .map(|f| Snapshot::new(f, spec.scene.dimension))
-                        .collect(),
-                    cpu_s,
-                    threads: Some(threads),
-                };
+                let snapshots =
+                    report.snapshots.iter().map(|f| Snapshot::new(f, spec.scene.dimension)).collect();
+                let record =
+                    spec.record(report.summary, CachedProbes::from(report.probes), snapshots, cpu_s, threads);
                 cache::store(&path, &record)?;
                 Ok(Ran::Finished { record: Box::new(record), reused: false })
             }

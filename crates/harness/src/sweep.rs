@@ -34,6 +34,32 @@ pub struct RunSpec {
 }
 
 impl RunSpec {
+    /// The cache record of this run once it finished: its summary, probes and snapshots,
+    /// and how it ran (CPU seconds, threads).
+    pub fn record(
+        &self,
+        summary: meniscus::Summary,
+        probes: crate::cache::CachedProbes,
+        snapshots: Vec<crate::snapshots::Snapshot>,
+        cpu_s: Option<f64>,
+        threads: usize,
+    ) -> crate::cache::RunRecord {
+        crate::cache::RunRecord {
+            completed: true,
+            slug: self.slug.clone(),
+            scheme: self.scheme.clone(),
+            preset: self.preset.clone(),
+            dx: self.dx,
+            scene_hash: self.hash.clone(),
+            scene: self.scene_json.clone(),
+            summary,
+            probes,
+            snapshots,
+            cpu_s,
+            threads: Some(threads),
+        }
+    }
+
     /// The run `slug` of `case` (or of a study) with preset `preset` at spacing `dx` and the
     /// checked `scene`, which it canonicalises and hashes.
     pub fn new(case: &str, slug: String, preset: &str, dx: f64, scene: meniscus::Scene) -> Result<RunSpec> {

@@ -77,20 +77,8 @@ impl Spool {
             }
         }
         let cpu_s = std::fs::read_to_string(out.join("cpu.txt")).ok().and_then(|t| parse_times(&t));
-        Ok(RunRecord {
-            completed: true,
-            slug: spec.slug.clone(),
-            scheme: spec.scheme.clone(),
-            preset: spec.preset.clone(),
-            dx: spec.dx,
-            scene_hash: spec.hash.clone(),
-            scene: spec.scene_json.clone(),
-            threads: Some(summary.threads),
-            summary,
-            probes,
-            snapshots,
-            cpu_s,
-        })
+        let threads = summary.threads;
+        Ok(spec.record(summary, probes, snapshots, cpu_s, threads))
     }
 
     /// Writes a job array's directory `arrays/<name>/`: the batch script running each of
