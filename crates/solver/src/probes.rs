@@ -9,6 +9,8 @@ use crate::state::{State, Vector};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
+mod young_laplace;
+
 /// Recorded probe series.
 #[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct ProbeRecord {
@@ -163,11 +165,16 @@ pub struct ProbeSet<const D: usize> {
     clusters: Option<(CellSearch<D>, NeighbourList, Vec<u32>)>,
     /// Scratch: the rings of an axisymmetric body as copies around the axis.
     view: Revolved<D>,
+    /// The fluid's surface tension γ \[N/m\] (the `young_laplace` probe's `γ κ`).
+    surface_tension: f64,
+    /// Scratch of the `young_laplace` probe.
+    outline: young_laplace::Scratch,
 }
 
 impl<const D: usize> ProbeSet<D> {
-    /// Probes of a scene; repeated kinds get `_1`, `_2`, ... suffixes.
-    pub fn new(probes: &[Probe], weight: Weight, dx: f64, domain: Domain<D>) -> Self {
+    /// Probes of a scene; repeated kinds get `_1`, `_2`, ... suffixes. `surface_tension`
+    /// \[N/m\] is the fluid's γ (the `young_laplace` probe's).
+    pub fn new(probes: &[Probe], weight: Weight, dx: f64, domain: Domain<D>, surface_tension: f64) -> Self {
         let probes: Vec<(String, Probe)> =
             crate::scene::probe_keys(probes).into_iter().zip(probes.iter().cloned()).collect();
         let search = probes
@@ -178,7 +185,16 @@ impl<const D: usize> ProbeSet<D> {
             .iter()
             .any(|(_, p)| matches!(p, Probe::DropShape {}))
             .then(|| (CellSearch::new(2.0 * dx, domain), NeighbourList::default(), Vec::new()));
-        Self { probes, weight, search, bins: Default::default(), clusters, view: Revolved::default() }
+        Self {
+            probes,
+            weight,
+            search,
+            bins: Default::default(),
+            clusters,
+            view: Revolved::default(),
+            surface_tension,
+            outline: Default::default(),
+        }
     }
 
     /// Appends one sample of every probe at time `t`.
@@ -378,6 +394,23 @@ impl<const D: usize> ProbeSet<D> {
                     out.push(key, "diameter", diameter);
                     out.push(key, "width", width);
                     out.push(key, "height", height);
+                }
+                Probe::YoungLaplace { above } => {
+                    let input = young_laplace::Input {
+                        x,
+                        p: pressure,
+                        outline: &s.outline,
+                        dx: s.dx,
+                        support: self.weight.support,
+                        gamma: self.surface_tension,
+                        above: *above,
+                    };
+                    let c = young_laplace::compare(&input, &mut self.outline);
+                    out.push(key, "error_rms", c.rms);
+                    out.push(key, "error_max", c.max);
+                    out.push(key, "laplace_mean", c.laplace);
+                    out.push(key, "p_mean", c.p);
+                    out.push(key, "count", c.count as f64);
                 }
                 Probe::Solver {} => {
                     out.push(

@@ -211,7 +211,7 @@ impl<const D: usize> Simulation<D> {
         Self {
             scene: scene.clone(),
             guard: Guard::new(scene, state, support),
-            probes: ProbeSet::new(&scene.probes, weight, scene.dx, state.domain),
+            probes: ProbeSet::new(&scene.probes, weight, scene.dx, state.domain, scene.fluid.surface_tension),
             method,
             last_good: LastGood::default(),
             max_steps: usize::MAX,

@@ -97,5 +97,6 @@ fn state_around<const D: usize>(
         links: Default::default(),
         moments: Vec::new(),
         solve: Default::default(),
+        outline: Vec::new(),
     }
 }

@@ -129,6 +129,10 @@ pub struct State<const D: usize> {
     pub moments: Vec<Option<crate::fields::Matrix<D>>>,
     /// Iterations and residual of the step's pressure solve (none for explicit schemes).
     pub solve: crate::linalg::SolveInfo,
+    /// A scheme's own outline of its fluid \[m\], counter-clockwise (OTM's boundary
+    /// polyline in 2D), which the `young_laplace` probe reads instead of tracing one from the
+    /// particles; empty for the particle schemes.
+    pub outline: Vec<Vector<D>>,
 }
 
 /// The inlet buffer's pressure link (zero normal gradient at the inlet): every buffer

@@ -18,7 +18,11 @@ fn static_drop(dx: f64, end: f64) -> Value {
         "bodies": [{"role": "fluid", "shape": {"circle": {"center": [0.0, 0.0], "radius": 0.2}}}],
         "scheme": {"otm": {"sound_speed": 50.0}},
         "time": {"end": end, "step": {"adaptive": {"cfl": 0.25, "viscous": 0.2, "max": 0.001}}},
-        "probes": [{"mean_pressure": {"center": [0.0, 0.0], "radius": 0.2}}, {"kinetic_energy": {}}],
+        "probes": [
+            {"mean_pressure": {"center": [0.0, 0.0], "radius": 0.2}},
+            {"kinetic_energy": {}},
+            {"young_laplace": {}}
+        ],
         "output": {"probe_every": 10}
     })
 }
@@ -37,6 +41,12 @@ fn the_static_drop_settles_at_the_laplace_pressure() {
     let p = report.probes.get("mean_pressure", "p").expect("recorded");
     let last = *p.last().unwrap();
     assert!((last / 5.0 - 1.0).abs() < 0.01, "mean pressure {last} Pa");
+    // On the boundary nodes' outline (a circle): γ κ = σ/R = 5 Pa, and the pressure read
+    // there from the points inside.
+    let outline = |q: &str| *report.probes.get("young_laplace", q).expect("recorded").last().unwrap();
+    assert_eq!(outline("count"), 60.0, "the outermost ring's 6 K nodes");
+    assert!((outline("laplace_mean") / 5.0 - 1.0).abs() < 0.01, "{}", outline("laplace_mean"));
+    assert!(outline("error_rms") < 0.02 * 5.0, "{}", outline("error_rms"));
     assert_eq!(report.summary.particles, 600, "one material point per triangle: 6 K² for K = 10 rings");
     let mut three = static_drop(0.02, 1e-3);
     three["scheme"]["otm"]["quadrature"] = json!("degree_two");

@@ -268,6 +268,13 @@ fn malformed_scene_table() {
                 json!([{"role": "fluid", "shape": {"sphere": {"center": [0.0, 0.0, 0.0], "radius": 0.2}}}]);
             v["probes"] = json!([{"ellipse_axes": {}}]);
         }),
+        ("probes[0].young_laplace", "2D", |v| {
+            v["dimension"] = json!(3);
+            v["body_force"] = json!([]);
+            v["bodies"] =
+                json!([{"role": "fluid", "shape": {"sphere": {"center": [0.0, 0.0, 0.0], "radius": 0.2}}}]);
+            v["probes"] = json!([{"young_laplace": {}}]);
+        }),
         // Shapes: wrong dimension, no particles, min ≥ max, too far out.
         ("bodies[0].shape.sphere", "3D shape", |v| {
             v["bodies"][0]["shape"] = json!({"sphere": {"center": [0.0, 0.0, 0.0], "radius": 1.0}})

@@ -7,7 +7,12 @@
 //! - `dp_transverse_late`: the largest component across g over the last quarter, over
 //!   `ρ|g|` (0 at rest);
 //! - `dpdg_late` \[Pa/m\]: the gradient along g, averaged over the last quarter;
-//! - `u_max_late` \[m/s\]: the largest particle speed over the last quarter (`max_speed`).
+//! - `u_max_late` \[m/s\]: the largest particle speed over the last quarter (`max_speed`);
+//! - with a `young_laplace` probe, the outline's pressure against `γ κ` of the local circle
+//!   fits (Zhou 2021 §3.4), each over the mean `γ κ` and averaged over the last quarter:
+//!   `young_laplace_rel_err_late` (the RMS of `p − γ κ` over the outline),
+//!   `young_laplace_bias_late` (the mean of `p − γ κ`, signed) and
+//!   `young_laplace_max_rel_late` (the largest `|p − γ κ|`, the largest over the quarter).
 
 use super::{Measured, nan_max, rel_err_final, rel_err_late};
 use meniscus::ProbeRecord;
@@ -68,6 +73,22 @@ pub fn compute(rho_g: &[f64], probes: &ProbeRecord) -> Result<Measured, Referenc
     if let Some(u) = probes.get("max_speed", "u_max") {
         m.metrics.insert("u_max_late".into(), nan_max(&late(u)));
     }
+    if let (Some(rms), Some(max), Some(laplace), Some(p)) = (
+        probes.get("young_laplace", "error_rms"),
+        probes.get("young_laplace", "error_max"),
+        probes.get("young_laplace", "laplace_mean"),
+        probes.get("young_laplace", "p_mean"),
+    ) {
+        let over = |v: &[f64]| -> Vec<f64> { v.iter().zip(laplace).map(|(e, l)| e / l).collect() };
+        let bias: Vec<f64> = p.iter().zip(laplace).map(|(p, l)| (p - l) / l).collect();
+        let mean = |v: Vec<f64>| v.iter().sum::<f64>() / v.len() as f64;
+        m.metrics.insert("young_laplace_rel_err_late".into(), mean(late(&over(rms))));
+        m.metrics.insert("young_laplace_bias_late".into(), mean(late(&bias)));
+        m.metrics.insert("young_laplace_max_rel_late".into(), nan_max(&late(&over(max))));
+        m.series.insert("young_laplace_rel_err".into(), over(rms));
+        m.series.insert("young_laplace_p".into(), p.to_vec());
+        m.series.insert("young_laplace_ref".into(), laplace.to_vec());
+    }
     m.series.insert("t".into(), t.clone());
     m.series.insert("dpdg".into(), along);
     m.series.insert("dpdg_ref".into(), reference);
@@ -92,5 +113,24 @@ mod tests {
         assert!((m["dp_transverse_late"] - 0.01).abs() < 1e-12);
         let e = gravity(&serde_json::json!({"fluid": {"density": 1.0}, "body_force": [0.0, 0.0]}));
         assert!(e.is_err());
+        assert!(!m.contains_key("young_laplace_rel_err_late"), "no young_laplace probe, no metric");
+    }
+
+    /// The outline's RMS and mean error over the mean `γ κ`, averaged over the last quarter
+    /// (the first three quarters, far off, do not count).
+    #[test]
+    fn the_outline_error_is_read_over_the_last_quarter() {
+        let t: Vec<f64> = (0..=100).map(|i| i as f64 * 0.04).collect();
+        let early = |late: f64, off: f64| t.iter().map(|ti| if *ti < 3.0 { off } else { late }).collect();
+        let mut r = ProbeRecord { t: t.clone(), ..Default::default() };
+        let y = r.series.entry("young_laplace".into()).or_default();
+        y.insert("error_rms".into(), early(0.5, 9.0));
+        y.insert("error_max".into(), early(1.0, 9.0));
+        y.insert("laplace_mean".into(), vec![10.0; t.len()]);
+        y.insert("p_mean".into(), early(9.8, 0.0));
+        let m = compute(&[0.0, -10.0], &r).unwrap().metrics;
+        assert!((m["young_laplace_rel_err_late"] - 0.05).abs() < 1e-12, "{m:?}");
+        assert!((m["young_laplace_bias_late"] + 0.02).abs() < 1e-12, "{m:?}");
+        assert!((m["young_laplace_max_rel_late"] - 0.1).abs() < 1e-12, "{m:?}");
     }
 }

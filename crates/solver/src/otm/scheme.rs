@@ -189,6 +189,7 @@ impl<const D: usize> Scheme<D> for Otm {
         state.volumes = body.volume.clone();
         state.volume = body.area() / n as f64;
         state.axis = (place.geometry == Geometry::Axisymmetric).then_some(place.axis);
+        outline(&body, &place, &mut state.outline);
         let stages: Vec<Box<dyn Stage<D, OtmData<D>>>> = vec![Box::new(OtmStep { place })];
         Ok(Composed { scheme: Otm, state, own: OtmData { body: Some(body) }, stages })
     }
@@ -200,6 +201,15 @@ impl<const D: usize> Scheme<D> for Otm {
                 .min(crate::time_step::capillary(density, b.h, surface_tension))
                 .min(rule.max)
         })
+    }
+}
+
+/// The plane body's boundary polyline as the state's outline (none axisymmetric: the
+/// probes' outline is 2D).
+fn outline<const D: usize>(body: &Body, place: &Placement, out: &mut Vec<Vector<D>>) {
+    out.clear();
+    if place.geometry == Geometry::Plane {
+        out.extend(body.boundary.iter().map(|&a| place.lift::<D>(&body.nodes[a])));
     }
 }
 
@@ -226,6 +236,7 @@ impl<const D: usize> Stage<D, OtmData<D>> for OtmStep {
             *u = self.place.lift_vector::<D>(&v);
         }
         state.volumes.copy_from_slice(&body.volume);
+        outline(body, &self.place, &mut state.outline);
         Ok(())
     }
 }

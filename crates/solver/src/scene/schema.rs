@@ -1098,6 +1098,17 @@ pub enum Probe {
         #[serde(default)]
         layer: Option<f64>,
     },
+    /// The pressure on a 2D drop's outline against Young–Laplace (Zhou 2021 §3.4): each
+    /// outline point (the farthest point from the centroid in sectors about 2 Δx wide)
+    /// against `γ κ`, κ from the least-squares circle through it and its two neighbours on
+    /// each side: `error_rms` and `error_max` of `p − γ κ`, `laplace_mean` (mean `γ κ`),
+    /// `p_mean` \[Pa\] and `count` over the points compared.
+    YoungLaplace {
+        /// Outline points below this height on y \[m\] shape the circle fits but are not
+        /// compared (the contact with a plate; all are compared when absent).
+        #[serde(default)]
+        above: Option<f64>,
+    },
 }
 
 /// A slab `range[0] <= x[axis] <= range[1]`.
@@ -1181,6 +1192,7 @@ impl Probe {
             Probe::MaxSpeed {} => "max_speed",
             Probe::DropShape {} => "drop_shape",
             Probe::Spread { .. } => "spread",
+            Probe::YoungLaplace { .. } => "young_laplace",
         }
     }
 }

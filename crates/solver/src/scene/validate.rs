@@ -159,6 +159,9 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
             vector(&format!("probes[{i}].pressure_gradient.center"), center, d)?;
             positive(&format!("probes[{i}].pressure_gradient.radius"), *radius)?;
         }
+        if let Probe::YoungLaplace { above: Some(y) } = probe {
+            finite(&format!("probes[{i}].young_laplace.above"), *y)?;
+        }
         if let Probe::Spread { axis, position, layer } = probe {
             let key = format!("probes[{i}].spread");
             if *axis >= d {
@@ -177,6 +180,9 @@ pub fn validate(scene: &Scene) -> Result<(), SceneError> {
         let only = match probe {
             Probe::EllipseAxes {} => Some((2, "is defined for 2D scenes only")),
             Probe::EllipsoidAxes {} => Some((3, "is defined for 3D scenes only (ellipse_axes in 2D)")),
+            Probe::YoungLaplace { .. } => {
+                Some((2, "is defined for 2D scenes only (the outline is traced in x–y)"))
+            }
             _ => None,
         };
         if let Some((want, rule)) = only
@@ -318,8 +324,9 @@ fn validate_ppe(field: &str, ppe: &PpeOptions) -> Result<(), SceneError> {
     Ok(())
 }
 
-/// The OTM scheme runs one 2D fluid body (a circle or a rectangle, meshed at `dx`)
-/// without walls, periodic or open boundaries (not built yet: issue #38).
+/// The OTM scheme runs one fluid body (in 2D a circle or a rectangle meshed at `dx`, in
+/// 3D a sphere solved axisymmetric) with plane walls and periodic axes; wall bodies and
+/// open boundaries are not built for it.
 fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
     positive("scheme.otm.sound_speed", o.sound_speed)?;
     if !(o.locality.is_finite() && o.locality > 0.0 && o.locality <= 10.0) {
@@ -334,7 +341,7 @@ fn validate_otm(o: &OtmOptions, scene: &Scene) -> Result<(), SceneError> {
         Err(SceneError::new(
             field,
             value,
-            "is not supported by the otm scheme yet (one free body, issue #38)",
+            "is not supported by the otm scheme (one fluid body; plane walls and periodic axes only)",
         ))
     };
     if scene.bodies.iter().any(|b| b.role == Role::Wall) {
