@@ -35,7 +35,7 @@ pub struct Args {
     #[arg(long)]
     dev_build: bool,
     #[command(flatten)]
-    executor: crate::executor::Args,
+    executor: crate::executor::ExecutorArgs,
 }
 
 /// Runs the study and prints the targets' verdicts; exits 1 when a target is missed (the

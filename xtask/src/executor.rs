@@ -19,7 +19,7 @@ pub enum Executor {
 
 /// The executor flags.
 #[derive(Debug, clap::Args)]
-pub struct Args {
+pub struct ExecutorArgs {
     /// Where runs that are not cached run: `local` (this machine) or `slurm` (job arrays
     /// through sbatch; the options below).
     #[arg(long, value_enum, default_value_t = Executor::Local)]
@@ -49,7 +49,7 @@ pub struct Args {
     meniscus: Option<PathBuf>,
 }
 
-impl Args {
+impl ExecutorArgs {
     /// The Slurm cluster to run on, checked before anything is submitted (`None`: local).
     /// A Slurm option without `--executor slurm` is an error.
     pub fn connect(&self, workspace: &Path) -> anyhow::Result<Option<Arc<Cluster>>> {

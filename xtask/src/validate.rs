@@ -40,7 +40,7 @@ pub struct Args {
     #[arg(long, value_name = "DIR")]
     baseline: Option<PathBuf>,
     #[command(flatten)]
-    executor: crate::executor::Args,
+    executor: crate::executor::ExecutorArgs,
 }
 
 /// Runs the validation; the exit code is 0 only when every check passes.
