@@ -44,7 +44,7 @@ fn the_static_drop_settles_at_the_laplace_pressure() {
     // On the boundary nodes' outline (a circle): γ κ = σ/R = 5 Pa, and the pressure read
     // there from the points inside.
     let outline = |q: &str| *report.probes.get("young_laplace", q).expect("recorded").last().unwrap();
-    assert_eq!(outline("count"), 60.0, "the outermost ring's 6 K nodes");
+    assert_eq!(outline("count") as usize, 60, "the outermost ring's 6 K nodes");
     assert!((outline("laplace_mean") / 5.0 - 1.0).abs() < 0.01, "{}", outline("laplace_mean"));
     assert!(outline("error_rms") < 0.02 * 5.0, "{}", outline("error_rms"));
     assert_eq!(report.summary.particles, 600, "one material point per triangle: 6 K² for K = 10 rings");
