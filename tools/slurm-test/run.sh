@@ -45,7 +45,10 @@ done
 [ "$state" = "idle" ] || fail "the node did not come up (state \`$state\`): $(tail -n 5 "$dir/log/slurmd.log" "$dir/log/slurmctld.log")"
 echo "slurm-test: one-node cluster up on $host ($(sinfo --version))"
 
-# The tasks run this build's meniscus binary (the tests check its solver fingerprint).
-cargo build --quiet -p meniscus-cli
+# The tasks run this build's meniscus binary (the tests check its solver fingerprint), the
+# one `cargo test --workspace` builds for the command line's tests: the same command builds
+# it here (nothing to do after the README's test command; a plain `cargo build` would
+# resolve other features and rebuild the dependencies).
+cargo test --quiet --workspace --no-run
 MENISCUS_BIN="$(pwd)/target/debug/meniscus" \
-  cargo test -p meniscus-harness --test slurm -- --ignored --test-threads=1
+  cargo test --workspace --test slurm -- --ignored --test-threads=1
