@@ -1,7 +1,8 @@
 //! The solver fingerprint ([`meniscus::SOLVER_FINGERPRINT`], from
 //! `MENISCUS_SOLVER_FINGERPRINT`): SHA-256 of what a run's result depends on — this
-//! crate's sources and manifest, the workspace's `Cargo.lock` (its dependencies) and the
-//! compiler's version — and of nothing in the harness or the command line. The harness
+//! crate's sources and manifest, the workspace's `Cargo.toml` and `Cargo.lock` (so a
+//! dependency added anywhere in the workspace changes it) and the compiler's version — and
+//! of no source file of the harness or the command line. The harness
 //! keys its cached runs by it (a change to the harness, its metrics or its reports
 //! re-evaluates the cached runs instead of rerunning them: issue #33), and the `meniscus`
 //! binary prints it (`meniscus --version`), so that runs handed to it by the Slurm executor

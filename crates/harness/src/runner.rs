@@ -292,6 +292,7 @@ impl Runner {
         jobs: &[(&Path, &Job)],
         finish: impl Fn(usize, Ran) -> Result<(T, String)>,
     ) -> Result<Vec<T>> {
+        let before = self.tally();
         let units: Vec<u64> = jobs.iter().map(|(_, j)| bar_units(j.cost)).collect();
         let batch = bar.map(|name| self.progress.batch_bar(name, units.iter().sum(), jobs.len()));
         let mut items: Vec<Option<T>> = jobs.iter().map(|_| None).collect();
@@ -345,7 +346,9 @@ impl Runner {
             let t = self.tally();
             b.finish_with_message(format!(
                 "{} run on slurm, {} cached, {} failed",
-                t.executed, t.reused, t.failed
+                t.executed - before.executed,
+                t.reused - before.reused,
+                t.failed - before.failed
             ));
         }
         Ok(items.into_iter().map(|i| i.expect("every job ended")).collect())

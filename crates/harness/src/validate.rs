@@ -107,7 +107,9 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
                     // A perturbed start costs what its unperturbed run cost.
                     let unperturbed = crate::results::slug(&spec.scheme, &spec.preset, spec.dx);
                     let previous = measured.get(&spec.slug).or_else(|| measured.get(&unperturbed)).copied();
-                    plan(spec, previous)
+                    let job = plan(spec, previous);
+                    // The wide-run thread count is this machine's: on Slurm, --cpus-per-task.
+                    if opts.slurm.is_some() { Job { threads: None, ..job } } else { job }
                 })
                 .collect();
             Ok((dir, jobs))

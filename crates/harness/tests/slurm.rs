@@ -157,7 +157,8 @@ fn bad_partitions_and_spools_are_refused_before_submitting() {
     let e = error("nosuch", dir.join("spool"));
     assert!(e.contains("--partition") && e.contains("nosuch"), "{e}");
     // `remote` holds a node that is not this host (tools/slurm-test/slurm.conf).
-    let e = error("remote", std::env::temp_dir().join("meniscus-slurm-spool"));
+    let local = std::env::temp_dir().join("meniscus-slurm-spool");
+    let e = error("remote", local.clone());
     assert!(e.contains("--spool") && e.contains("node-local"), "{e}");
-    assert!(!dir.join("spool/arrays").exists(), "nothing was submitted");
+    assert!(!dir.join("spool/arrays").exists() && !local.join("arrays").exists(), "nothing was submitted");
 }

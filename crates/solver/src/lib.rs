@@ -46,8 +46,8 @@ pub use run::{AnySimulation, Observer, Quiet, RunReport, Status, Summary, run};
 pub use scene::Scene;
 
 /// The solver's fingerprint: SHA-256 (hex) of its sources, manifest, the workspace's
-/// `Cargo.lock` and the compiler's version (`build.rs`). Two builds with the same
-/// fingerprint give the same runs.
+/// `Cargo.toml` and `Cargo.lock` and the compiler's version (`build.rs`). Two builds with
+/// the same fingerprint (and no other compiler flags) give the same runs.
 pub const SOLVER_FINGERPRINT: &str = env!("MENISCUS_SOLVER_FINGERPRINT");
 
 /// `<package version> (solver <fingerprint>)`: what `meniscus --version` prints.

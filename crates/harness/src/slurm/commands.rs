@@ -77,12 +77,21 @@ pub struct TaskState {
 }
 
 impl TaskState {
-    /// Whether the task has ended (any state but pending, running, configuring, completing,
-    /// suspended or requeued).
+    /// Whether the task has ended: one of Slurm's terminal states (any other, such as
+    /// `STOPPED`, `REQUEUE_HOLD` or `STAGE_OUT`, is still followed).
     pub fn ended(&self) -> bool {
-        !matches!(
+        matches!(
             self.state.as_str(),
-            "PENDING" | "RUNNING" | "CONFIGURING" | "COMPLETING" | "SUSPENDED" | "REQUEUED" | "RESIZING"
+            "COMPLETED"
+                | "FAILED"
+                | "CANCELLED"
+                | "TIMEOUT"
+                | "NODE_FAIL"
+                | "OUT_OF_MEMORY"
+                | "BOOT_FAIL"
+                | "DEADLINE"
+                | "PREEMPTED"
+                | "REVOKED"
         )
     }
 }

@@ -47,9 +47,10 @@ pub struct SlurmOptions {
     pub poll: Duration,
 }
 
-/// How long a task that Slurm reports ended may take to show its outputs (a shared file
-/// system's attribute cache) before it counts as failed.
-const GRACE: Duration = Duration::from_secs(30);
+/// How long a task that Slurm reports completed may take to show its outputs (a shared
+/// file system's attribute cache: NFS keeps a directory's for up to 60 s by default) before
+/// it counts as failed.
+const GRACE: Duration = Duration::from_secs(90);
 
 /// File-system types that a cluster's nodes share (`/proc/self/mountinfo`'s type field).
 const SHARED_FILE_SYSTEMS: &[&str] = &[
@@ -111,8 +112,11 @@ impl Counts {
     }
 }
 
-/// Set by Ctrl-C while arrays are being followed.
+/// Set by Ctrl-C (or SIGTERM, SIGHUP) while arrays are being followed.
 static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Whether arrays are being followed: a signal at any other time ends the process.
+static FOLLOWING: AtomicBool = AtomicBool::new(false);
 
 fn slurm_error(message: impl Into<String>) -> HarnessError {
     HarnessError::Slurm { message: message.into() }
@@ -157,11 +161,6 @@ impl Cluster {
         Ok(Cluster { spool: Spool::new(spool_path), opts, partition })
     }
 
-    /// The spool directory.
-    pub fn spool(&self) -> &Spool {
-        &self.spool
-    }
-
     /// Runs `runs` (`(key, spec, threads)`; `threads` `None`: `--cpus-per-task`): each
     /// finished in the spool already (unless `rerun`) is collected at once, the others are
     /// submitted; `report(key, outcome)` is called as each ends, `progress` after each look
@@ -178,26 +177,38 @@ impl Cluster {
         // Arrays to submit: threads → runs.
         let mut groups: BTreeMap<usize, Vec<(usize, &RunSpec)>> = BTreeMap::new();
         for &(key, spec, threads) in runs {
-            if !rerun && self.spool.finished(spec) {
-                report(key, self.collect(spec))?;
+            let threads = threads.unwrap_or(self.opts.cpus_per_task);
+            // Finished after an earlier invocation stopped: collected, unless its outputs
+            // cannot be read (then they are dropped and the run submitted again).
+            let earlier = (!rerun && self.spool.finished(spec, threads))
+                .then(|| self.spool.collect(spec, threads).ok())
+                .flatten();
+            if let Some(record) = earlier {
+                report(key, Outcome::Finished(Box::new(record)))?;
                 counts.done += 1;
                 continue;
             }
-            self.spool.prepare(spec, rerun)?;
-            groups.entry(threads.unwrap_or(self.opts.cpus_per_task)).or_default().push((key, spec));
+            self.spool.prepare(spec, threads)?;
+            groups.entry(threads).or_default().push((key, spec));
         }
         if groups.is_empty() {
             return Ok(());
         }
         install_interrupt_handler();
+        INTERRUPTED.store(false, Ordering::SeqCst);
+        // Cancels what was submitted on any early return (an error, an interruption).
+        let mut submitted = Submitted::default();
+        FOLLOWING.store(true, Ordering::SeqCst);
         let mut arrays = Vec::new();
         for (threads, tasks) in groups {
-            arrays.push(self.submit(threads, tasks)?);
+            let array = self.submit(threads, tasks)?;
+            submitted.0.push(array.id);
+            arrays.push(array);
         }
         loop {
             if INTERRUPTED.swap(false, Ordering::SeqCst) {
-                let ids: Vec<String> = arrays.iter().map(|a| a.id.to_string()).collect();
-                let cancelled = run("scancel", &ids.iter().map(String::as_str).collect::<Vec<_>>());
+                let ids: Vec<String> = submitted.0.iter().map(u64::to_string).collect();
+                let cancelled = submitted.cancel();
                 return Err(slurm_error(format!(
                     "interrupted: Slurm job(s) {} {}; runs that finished are kept, run the command \
                      again to submit the others",
@@ -208,13 +219,18 @@ impl Cluster {
                     }
                 )));
             }
-            let (mut pending, mut running) = (0, 0);
+            let (mut pending, mut running, mut seen) = (0, 0, true);
             for array in &mut arrays {
-                let (p, r) = array.poll(self, &mut counts, report)?;
-                (pending, running) = (pending + p, running + r);
+                match array.poll(self, &mut counts, report)? {
+                    Some((p, r)) => (pending, running) = (pending + p, running + r),
+                    None => seen = false,
+                }
             }
-            progress(Counts { pending, running, ..counts });
+            if seen {
+                progress(Counts { pending, running, ..counts });
+            }
             if arrays.iter().all(|a| a.tasks.iter().all(|t| t.ended)) {
+                submitted.0.clear();
                 return Ok(());
             }
             std::thread::sleep(self.opts.poll);
@@ -222,8 +238,8 @@ impl Cluster {
     }
 
     /// The record of a finished run, or why it cannot be read.
-    fn collect(&self, spec: &RunSpec) -> Outcome {
-        match self.spool.collect(spec) {
+    fn collect(&self, spec: &RunSpec, threads: usize) -> Outcome {
+        match self.spool.collect(spec, threads) {
             Ok(record) => Outcome::Finished(Box::new(record)),
             Err(e) => Outcome::Failed(format!("its outputs could not be read: {e}")),
         }
@@ -234,20 +250,21 @@ impl Cluster {
         let stamp =
             std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
         let name = format!("{stamp}-{}-t{threads}", std::process::id());
-        let dirs: Vec<PathBuf> = tasks.iter().map(|(_, spec)| self.spool.run_dir(spec)).collect();
+        let dirs: Vec<PathBuf> = tasks.iter().map(|(_, spec)| self.spool.run_dir(spec, threads)).collect();
         let dir = self.spool.write_array(&name, &dirs, &self.opts.meniscus, threads)?;
         let mut range = format!("0-{}", tasks.len() - 1);
         if let Some(max) = self.opts.max_tasks {
             range.push_str(&format!("%{max}"));
         }
-        let log = dir.join("task_%a.log");
+        // `%` is sbatch's pattern character: the directory's own are doubled.
+        let log = format!("{}/task_%a.log", dir.display().to_string().replace('%', "%%"));
         let mut args = vec![
             "--parsable".to_string(),
             format!("--array={range}"),
             "--job-name=meniscus".to_string(),
             format!("--partition={}", self.partition),
             format!("--cpus-per-task={threads}"),
-            format!("--output={}", log.display()),
+            format!("--output={log}"),
         ];
         if let Some(account) = &self.opts.account {
             args.push(format!("--account={account}"));
@@ -262,7 +279,7 @@ impl Cluster {
         crate::io::write_atomic(&dir.join("job_id"), format!("{id}\n").as_bytes())?;
         let tasks =
             tasks.into_iter().map(|(key, spec)| Task { key, spec, ended: false, since: None }).collect();
-        Ok(Array { id, dir, tasks })
+        Ok(Array { id, dir, threads, tasks })
     }
 }
 
@@ -270,7 +287,31 @@ impl Cluster {
 struct Array<'a> {
     id: u64,
     dir: PathBuf,
+    threads: usize,
     tasks: Vec<Task<'a>>,
+}
+
+/// The job ids submitted by one [`Cluster::run`], cancelled when dropped unless cleared.
+#[derive(Default)]
+struct Submitted(Vec<u64>);
+
+impl Submitted {
+    /// `scancel` of every submitted job; nothing is left to cancel after it.
+    fn cancel(&mut self) -> std::result::Result<(), commands::CommandError> {
+        if self.0.is_empty() {
+            return Ok(());
+        }
+        let ids: Vec<String> = self.0.drain(..).map(|id| id.to_string()).collect();
+        run("scancel", &ids.iter().map(String::as_str).collect::<Vec<_>>()).map(|_| ())
+    }
+}
+
+impl Drop for Submitted {
+    fn drop(&mut self) {
+        FOLLOWING.store(false, Ordering::SeqCst);
+        // An early return: the arrays would run on unfollowed (the error is the caller's).
+        let _ = self.cancel();
+    }
 }
 
 /// A task of an array.
@@ -279,36 +320,40 @@ struct Task<'a> {
     spec: &'a RunSpec,
     /// Reported (finished or failed).
     ended: bool,
-    /// When Slurm was first seen to have ended it without its outputs (the grace period).
+    /// Since when Slurm has reported it completed, or not listed it, without its outputs
+    /// being visible (the grace period).
     since: Option<Instant>,
 }
 
 impl Array<'_> {
     /// Reads the array's task states and reports the tasks that ended (counted in
-    /// `counts`); returns how many are pending and how many running.
+    /// `counts`); returns how many are pending and how many running, or `None` when the
+    /// queue could not be read (a busy controller: the next poll tries again).
     fn poll(
         &mut self,
         cluster: &Cluster,
         counts: &mut Counts,
         report: &mut dyn FnMut(usize, Outcome) -> Result<()>,
-    ) -> Result<(usize, usize)> {
+    ) -> Result<Option<(usize, usize)>> {
         let (mut pending, mut running) = (0, 0);
         let id = self.id.to_string();
-        // A failed look at the queue is retried at the next poll (the controller may be busy).
-        let queue = run("squeue", &["-h", "-r", "--states=all", "-j", &id, "-o", "%K %T"])
-            .map(|out| commands::parse_squeue(&out))
-            .unwrap_or_default();
+        let Ok(out) = run("squeue", &["-h", "-r", "--states=all", "-j", &id, "-o", "%K %T"]) else {
+            return Ok(None);
+        };
+        let queue = commands::parse_squeue(&out);
+        let threads = self.threads;
         let state: BTreeMap<usize, TaskState> = queue.into_iter().map(|s| (s.task, s)).collect();
         for k in 0..self.tasks.len() {
             let task = &mut self.tasks[k];
             if task.ended {
                 continue;
             }
-            let outcome = if cluster.spool.finished(task.spec) {
-                Some(cluster.collect(task.spec))
+            let outcome = if cluster.spool.finished(task.spec, threads) {
+                Some(cluster.collect(task.spec, threads))
             } else {
                 match state.get(&k) {
                     Some(s) if !s.ended() => {
+                        task.since = None;
                         if s.state == "PENDING" {
                             pending += 1;
                         } else {
@@ -326,8 +371,18 @@ impl Array<'_> {
                         if since.elapsed() < GRACE {
                             running += 1;
                             None
+                        } else if state.contains_key(&k) {
+                            let out = cluster.spool.run_dir(task.spec, threads).join("out");
+                            Some(Outcome::Failed(format!(
+                                "Slurm task {}_{k} completed, but `{}` holds no summary.json after \
+                                 {} s (log: {})",
+                                self.id,
+                                out.display(),
+                                GRACE.as_secs(),
+                                self.dir.join(format!("task_{k}.log")).display()
+                            )))
                         } else {
-                            Some(Outcome::Failed(self.failure(k, state.get(&k))))
+                            Some(Outcome::Failed(self.failure(k, None)))
                         }
                     }
                 }
@@ -342,7 +397,7 @@ impl Array<'_> {
                 report(task.key, outcome)?;
             }
         }
-        Ok((pending, running))
+        Ok(Some((pending, running)))
     }
 
     /// Why task `k` ended without outputs: its Slurm state and exit code (from `scontrol`,
@@ -378,13 +433,20 @@ impl Array<'_> {
     }
 }
 
-/// Ctrl-C sets [`INTERRUPTED`] (installed once per process).
+/// Ctrl-C, SIGTERM and SIGHUP set [`INTERRUPTED`] while arrays are followed, and end the
+/// process (exit code 130) otherwise (installed once per process).
 fn install_interrupt_handler() {
     static ONCE: std::sync::Once = std::sync::Once::new();
     ONCE.call_once(|| {
-        // A handler that cannot be installed leaves Ctrl-C to end the process, the arrays
-        // running on (the next invocation collects what they finish).
-        let _ = ctrlc::set_handler(|| INTERRUPTED.store(true, Ordering::SeqCst));
+        // A handler that cannot be installed leaves the signals to end the process, the
+        // arrays running on (the next invocation collects what they finish).
+        let _ = ctrlc::set_handler(|| {
+            if FOLLOWING.load(Ordering::SeqCst) {
+                INTERRUPTED.store(true, Ordering::SeqCst);
+            } else {
+                std::process::exit(130);
+            }
+        });
     });
 }
 
@@ -392,8 +454,9 @@ fn install_interrupt_handler() {
 fn check_binary(meniscus: &Path) -> Result<()> {
     if !meniscus.is_file() {
         return Err(slurm_error(format!(
-            "--meniscus: `{}` does not exist: build it with `cargo build -p meniscus-cli` (or name the \
-             binary with --meniscus)",
+            "--meniscus: `{}` does not exist: build it with `cargo build -p meniscus-cli` (`--release` \
+             for `cargo xtask bench`, which runs in the release build), or name the binary with \
+             --meniscus",
             meniscus.display()
         )));
     }

@@ -1,6 +1,7 @@
 //! The spool directory, on the file system the login node shares with the compute nodes:
 //!
-//! - `runs/<scene hash>/scene.json`: a run's effective scene; `out/` once its task has
+//! - `runs/<scene hash>-t<threads>/scene.json`: a run's effective scene (the thread count
+//!   in the name: the work-precision study runs one scene on several); `out/` once its task has
 //!   finished (the `meniscus run` outputs, `summary.json`, `probes.json`, `snapshots/`,
 //!   and `cpu.txt`, the task's CPU time), `out.partial/` while it runs. The directory is
 //!   keyed by the run's hash, so a run that finished after its submitter was stopped is
@@ -29,27 +30,23 @@ impl Spool {
         Spool { root }
     }
 
-    /// Its root directory.
-    pub fn root(&self) -> &Path {
-        &self.root
+    /// The directory of a run on `threads` threads.
+    pub fn run_dir(&self, spec: &RunSpec, threads: usize) -> PathBuf {
+        self.root.join("runs").join(format!("{}-t{threads}", spec.hash))
     }
 
-    /// The directory of a run.
-    pub fn run_dir(&self, spec: &RunSpec) -> PathBuf {
-        self.root.join("runs").join(&spec.hash)
+    /// Whether the run's task finished (its outputs are complete). Its directory is listed
+    /// first: on NFS that revalidates the directory's cached entries.
+    pub fn finished(&self, spec: &RunSpec, threads: usize) -> bool {
+        let dir = self.run_dir(spec, threads);
+        let _ = std::fs::read_dir(&dir).map(|entries| entries.count());
+        dir.join("out").join("summary.json").is_file()
     }
 
-    /// Whether the run's task finished (its outputs are complete).
-    pub fn finished(&self, spec: &RunSpec) -> bool {
-        self.run_dir(spec).join("out").join("summary.json").is_file()
-    }
-
-    /// Writes the run's scene for a task; `rerun` drops the outputs of an earlier task.
-    pub fn prepare(&self, spec: &RunSpec, rerun: bool) -> Result<PathBuf> {
-        let dir = self.run_dir(spec);
-        if rerun {
-            remove_dir(&dir.join("out"))?;
-        }
+    /// Writes the run's scene for a task, dropping the outputs of an earlier one.
+    pub fn prepare(&self, spec: &RunSpec, threads: usize) -> Result<PathBuf> {
+        let dir = self.run_dir(spec, threads);
+        remove_dir(&dir.join("out"))?;
         io::create_dir(&dir)?;
         io::write_json(&dir.join("scene.json"), &spec.scene_json)?;
         Ok(dir)
@@ -58,8 +55,8 @@ impl Spool {
     /// The record of a finished run (see [`Spool::finished`]), as the local executor would
     /// have stored it: the scene, summary, probes and snapshots from the task's outputs, the
     /// CPU time the task measured.
-    pub fn collect(&self, spec: &RunSpec) -> Result<RunRecord> {
-        let out = self.run_dir(spec).join("out");
+    pub fn collect(&self, spec: &RunSpec, threads: usize) -> Result<RunRecord> {
+        let out = self.run_dir(spec, threads).join("out");
         let summary: meniscus::Summary = io::read_json(&out.join("summary.json"))?;
         let probes: CachedProbes = io::read_json(&out.join("probes.json"))?;
         let mut snapshots = Vec::new();
@@ -113,8 +110,10 @@ pub fn batch_script(tasks: &Path, meniscus: &Path, threads: usize) -> String {
         "#!/bin/bash
 # One Meniscus run per array task, written by `cargo xtask validate --executor slurm`.
 set -u
+# bash's `times` below writes the C locale's decimal point.
+export LC_ALL=C
 run=$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" {tasks})
-if [ -z \"$run\" ]; then echo \"no run for task $SLURM_ARRAY_TASK_ID in {tasks}\" >&2; exit 2; fi
+if [ -z \"$run\" ]; then echo \"no run for task $SLURM_ARRAY_TASK_ID in \"{tasks} >&2; exit 2; fi
 rm -rf \"$run/out.partial\"
 {meniscus} run \"$run/scene.json\" --out \"$run/out.partial\" --threads {threads}
 rc=$?

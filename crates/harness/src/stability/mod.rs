@@ -349,15 +349,16 @@ impl Base {
     fn measure(&self, value: f64, slug: &str, ran: Ran) -> Result<Measured> {
         let record = match ran {
             Ran::Finished { record, .. } => record,
-            ran @ (Ran::Panicked { .. } | Ran::Failed { .. }) => {
-                let status = match ran {
-                    Ran::Panicked { message } => format!("panic: {message}"),
-                    other => other.status(),
-                };
+            // The executor could not run it: no verdict on stability (a bisection would read
+            // it as unstable).
+            Ran::Failed { message } => {
+                return Err(HarnessError::Slurm { message: format!("stability run `{slug}`: {message}") });
+            }
+            Ran::Panicked { message } => {
                 let trial = Trial {
                     value,
                     slug: slug.to_string(),
-                    status,
+                    status: format!("panic: {message}"),
                     steps: 0,
                     t_final: 0.0,
                     wall_s: 0.0,

@@ -148,7 +148,7 @@ fn plane_fit<const D: usize>(
         m += row * row.transpose() * w;
         rhs += row * (w * p[a]);
     }
-    // A plane needs three points off a line: the smallest pivot of the scaled system.
+    // A plane needs three points off a line: the determinant against the system's scale.
     let lu = m.lu();
     let s = lu.solve(&rhs)?;
     (m.determinant().abs() > 1e-12 * m.norm().powi(3)).then_some(s[0])

@@ -1099,9 +1099,10 @@ pub enum Probe {
         layer: Option<f64>,
     },
     /// The pressure on a 2D drop's outline against Young–Laplace (Zhou 2021 §3.4): each
-    /// outline point (the farthest point from the centroid in sectors about 2 Δx wide)
-    /// against `γ κ`, κ from the least-squares circle through it and its two neighbours on
-    /// each side: `error_rms` and `error_max` of `p − γ κ`, `laplace_mean` (mean `γ κ`),
+    /// outline point (the scheme's own outline, OTM's boundary nodes; else the farthest
+    /// particle from the centroid in sectors about 2 Δx wide) against `γ κ`, κ from the
+    /// least-squares circle through it and its two neighbours on each side: `error_rms` of
+    /// `p − γ κ` and `error_max`, the largest `|p − γ κ|`, `laplace_mean` (mean `γ κ`),
     /// `p_mean` \[Pa\] and `count` over the points compared.
     YoungLaplace {
         /// Outline points below this height on y \[m\] shape the circle fits but are not
