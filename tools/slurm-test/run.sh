@@ -16,10 +16,19 @@ done
 
 dir=$(mktemp -d /tmp/meniscus-slurm.XXXXXX)
 cleanup() {
-  for pid in "$dir"/*.pid "$dir"/munge/munged.pid; do
-    [ -f "$pid" ] && kill "$(cat "$pid")" 2>/dev/null || true
+  local pids=()
+  for file in "$dir"/*.pid "$dir"/munge/munged.pid; do
+    [ -f "$file" ] && pids+=("$(cat "$file")")
   done
-  rm -rf "$dir"
+  for pid in "${pids[@]}"; do kill "$pid" 2>/dev/null || true; done
+  # The daemons write their state while they stop: wait for them before removing it.
+  for _ in $(seq 1 50); do
+    alive=0
+    for pid in "${pids[@]}"; do kill -0 "$pid" 2>/dev/null && alive=1; done
+    [ "$alive" -eq 0 ] && break
+    sleep 0.2
+  done
+  rm -rf "$dir" 2>/dev/null || true
 }
 trap cleanup EXIT
 mkdir -p "$dir"/{state,spool,log,munge}
