@@ -5,11 +5,15 @@
 //! cluster's configuration) and `MENISCUS_BIN` (a `meniscus` binary of this solver build).
 //!
 //! - the quick drop sweep through Slurm writes the `results.json` of the local executor
-//!   (runs, metrics, orders and checks; not the wall and CPU times or the threads);
+//!   (runs, metrics, orders and checks; not the wall and CPU times or the threads), its
+//!   runs split into arrays of the cluster's `MaxArraySize` (8 in the test cluster);
 //! - a task killed mid-run is reported with its Slurm state, left uncached, and submitted
 //!   alone by the next invocation;
-//! - an unknown partition and a spool on a node-local file system for a partition of other
-//!   hosts are errors before anything is submitted.
+//! - tasks that wait for a reason Slurm does not clear by itself (here the partition's
+//!   `MaxTime` lowered below their time limit after the check) are cancelled and reported;
+//! - an unknown partition, a spool on a node-local file system for a partition of other
+//!   hosts, and a time limit that is not a Slurm time or exceeds the partition's `MaxTime`
+//!   are errors before anything is submitted.
 
 use meniscus_harness::slurm::{Cluster, SlurmOptions};
 use meniscus_harness::{Case, Tier, ValidateOptions, validate};
@@ -84,6 +88,8 @@ fn the_quick_drop_sweep_on_slurm_matches_the_local_one() {
     assert_eq!((there.executed, there.reused), (here.executed, 0));
     assert!(here.executed >= 10, "the quick drop sweep has its runs: {}", here.executed);
     assert_eq!(results(&cluster.join("reports")), results(&local.join("reports")));
+    let arrays = std::fs::read_dir(cluster.join("spool/arrays")).expect("the spool's arrays").count();
+    assert_eq!(arrays, here.executed.div_ceil(8), "arrays of at most MaxArraySize = 8 tasks");
     let runs = &there.results[0].runs;
     assert!(runs.iter().all(|r| r.cpu_s.is_some_and(|c| c > 0.0)), "each task's CPU time is recorded");
 }
@@ -160,5 +166,58 @@ fn bad_partitions_and_spools_are_refused_before_submitting() {
     let local = std::env::temp_dir().join("meniscus-slurm-spool");
     let e = error("remote", local.clone());
     assert!(e.contains("--spool") && e.contains("node-local"), "{e}");
+    // `short` allows one minute; the tests' tasks ask for ten.
+    let e = error("short", dir.join("spool"));
+    assert!(e.contains("--time-limit") && e.contains("`10`") && e.contains("MaxTime of 00:01:00"), "{e}");
+    let ten = SlurmOptions { time_limit: Some("ten".into()), ..options(None, dir.join("spool")) };
+    let e = Cluster::connect(ten).expect_err("refused").to_string();
+    assert!(e.contains("--time-limit") && e.contains("`ten` is not a Slurm time"), "{e}");
     assert!(!dir.join("spool/arrays").exists() && !local.join("arrays").exists(), "nothing was submitted");
+}
+
+/// Restores partition `short`'s one-minute `MaxTime` when dropped (also on a failed assertion).
+struct RestoreShort;
+
+impl Drop for RestoreShort {
+    fn drop(&mut self) {
+        let _ = std::process::Command::new("scontrol")
+            .args(["update", "PartitionName=short", "MaxTime=1"])
+            .status();
+    }
+}
+
+#[test]
+#[ignore = "needs a Slurm cluster: tools/slurm-test/run.sh"]
+fn tasks_that_would_never_start_are_cancelled_and_reported() {
+    let dir = workspace("never", false);
+    let opts = SlurmOptions { time_limit: Some("1".into()), ..options(Some("short"), dir.join("spool")) };
+    let cluster = Cluster::connect(opts).expect("a one-minute limit fits partition `short`");
+    // After the check, the partition's limit drops below the tasks' (an administrator's change).
+    let _restore = RestoreShort;
+    let status = std::process::Command::new("scontrol")
+        .args(["update", "PartitionName=short", "MaxTime=0"])
+        .status()
+        .expect("scontrol runs");
+    assert!(status.success(), "scontrol update PartitionName=short MaxTime=0");
+    let start = Instant::now();
+    let outcome =
+        validate(&ValidateOptions { slurm: Some(Arc::new(cluster)), ..ValidateOptions::quick_in(&dir) })
+            .expect("the sweep ends");
+    assert!(start.elapsed() < Duration::from_secs(60), "the sweep did not wait on its tasks");
+    let runs = &outcome.results[0].runs;
+    assert!(!runs.is_empty());
+    for run in runs {
+        assert!(
+            run.status.contains("does not clear by itself") && run.status.contains("PartitionTimeLimit"),
+            "{}",
+            run.status
+        );
+    }
+    assert!(!outcome.pass(), "runs that never ran fail their checks");
+    let queued = std::process::Command::new("squeue").args(["-h", "-p", "short"]).output().expect("squeue");
+    assert!(
+        queued.stdout.is_empty(),
+        "the tasks were cancelled: {}",
+        String::from_utf8_lossy(&queued.stdout)
+    );
 }

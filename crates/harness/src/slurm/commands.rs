@@ -74,6 +74,9 @@ pub struct TaskState {
     pub state: String,
     /// `<exit code>:<signal>`, when the source gives it (`scontrol`, `sacct`).
     pub exit_code: Option<String>,
+    /// Why a pending task waits (`Priority`, `Resources`, `PartitionTimeLimit`, …), when
+    /// the source gives it (`squeue`).
+    pub reason: Option<String>,
 }
 
 impl TaskState {
@@ -96,9 +99,31 @@ impl TaskState {
     }
 }
 
-/// The tasks of `squeue -h -r --states=all -j <job> -o "%K %T"` (array task index, state);
-/// lines without a single task index (a pending range such as `3-9%2` is expanded by `-r`)
-/// are skipped.
+/// Whether a pending task's `reason` is one that Slurm does not clear by itself: the request
+/// exceeds a limit of the partition, the QOS or the association *per job*, or names an
+/// account, QOS or constraint that is not allowed (Slurm's job reason codes). Such a task
+/// would wait until an administrator changes the limits; waits on other jobs (`Priority`,
+/// `Resources`, `QOSGrp*`, `AssocGrp*`, `Max*PerUser`, …) or on nodes coming back are not
+/// among them.
+pub fn never_starts(reason: &str) -> bool {
+    let per_job_limit =
+        (reason.starts_with("QOSMax") || reason.starts_with("AssocMax")) && reason.contains("PerJob");
+    per_job_limit
+        || matches!(
+            reason,
+            "PartitionTimeLimit"
+                | "AccountNotAllowed"
+                | "QOSNotAllowed"
+                | "InvalidAccount"
+                | "InvalidQOS"
+                | "BadConstraints"
+                | "DependencyNeverSatisfied"
+        )
+}
+
+/// The tasks of `squeue -h -r --states=all -j <job> -o "%K %T %r"` (array task index,
+/// state, reason); lines without a single task index (a pending range such as `3-9%2` is
+/// expanded by `-r`) are skipped.
 pub fn parse_squeue(squeue: &str) -> Vec<TaskState> {
     squeue
         .lines()
@@ -106,9 +131,54 @@ pub fn parse_squeue(squeue: &str) -> Vec<TaskState> {
             let mut f = l.split_whitespace();
             let task = f.next()?.parse().ok()?;
             let state = f.next()?.to_string();
-            Some(TaskState { task, state, exit_code: None })
+            let reason = f.collect::<Vec<_>>().join(" ");
+            Some(TaskState { task, state, exit_code: None, reason: (!reason.is_empty()).then_some(reason) })
         })
         .collect()
+}
+
+/// A Slurm time (`sbatch --time`, a partition's `MaxTime`) in seconds, `Some(None)` when
+/// unlimited (`UNLIMITED`, `INFINITE`, or 0, which asks for no limit); `None` when `time`
+/// is none of Slurm's formats: `minutes`, `minutes:seconds`, `hours:minutes:seconds`,
+/// `days-hours`, `days-hours:minutes`, `days-hours:minutes:seconds`.
+pub fn parse_time(time: &str) -> Option<Option<u64>> {
+    let time = time.trim();
+    if matches!(time, "UNLIMITED" | "INFINITE" | "infinite" | "unlimited") {
+        return Some(None);
+    }
+    let number = |s: &str| -> Option<u64> {
+        (!s.is_empty() && s.bytes().all(|b| b.is_ascii_digit())).then(|| s.parse().ok()).flatten()
+    };
+    let seconds = match time.split_once('-') {
+        Some((days, rest)) => {
+            let f: Vec<&str> = rest.split(':').collect();
+            let (h, m, s) = match f[..] {
+                [h] => (number(h)?, 0, 0),
+                [h, m] => (number(h)?, number(m)?, 0),
+                [h, m, s] => (number(h)?, number(m)?, number(s)?),
+                _ => return None,
+            };
+            ((number(days)? * 24 + h) * 60 + m) * 60 + s
+        }
+        None => {
+            let f: Vec<&str> = time.split(':').collect();
+            match f[..] {
+                [m] => number(m)? * 60,
+                [m, s] => number(m)? * 60 + number(s)?,
+                [h, m, s] => (number(h)? * 60 + number(m)?) * 60 + number(s)?,
+                _ => return None,
+            }
+        }
+    };
+    Some((seconds > 0).then_some(seconds))
+}
+
+/// The value of `key` in `scontrol show config` (`Key = value` lines).
+pub fn config_value<'a>(config: &'a str, key: &str) -> Option<&'a str> {
+    config.lines().find_map(|l| {
+        let (k, v) = l.split_once('=')?;
+        (k.trim() == key).then(|| v.trim())
+    })
 }
 
 /// The value of `key` in a line of `scontrol -o` (`Key=value` pairs split by spaces).
@@ -127,6 +197,7 @@ pub fn parse_scontrol(scontrol: &str) -> Vec<TaskState> {
                 task: field("ArrayTaskId")?.parse().ok()?,
                 state: field("JobState")?.to_string(),
                 exit_code: field("ExitCode").map(str::to_string),
+                reason: None,
             })
         })
         .collect()
@@ -141,7 +212,7 @@ pub fn parse_sacct(sacct: &str) -> Vec<TaskState> {
             let id = f.next()?;
             let task = id.split_once('_')?.1.parse().ok()?;
             let state = f.next()?.split_whitespace().next()?.to_string();
-            Some(TaskState { task, state, exit_code: f.next().map(str::to_string) })
+            Some(TaskState { task, state, exit_code: f.next().map(str::to_string), reason: None })
         })
         .collect()
 }
@@ -162,10 +233,20 @@ mod tests {
         assert_eq!(field(partition, "Nodes"), Some("ghost[1-2]"));
         assert_eq!(field(partition, "TotalNodes"), Some("2"));
         assert_eq!(field(partition, "Missing"), None);
-        let q = parse_squeue("2 PENDING\n1 RUNNING\n3 COMPLETED\nN/A PENDING\n");
-        assert_eq!(q.len(), 3);
+        let q = parse_squeue(
+            "2 PENDING Resources\n1 RUNNING None\n3 COMPLETED None\nN/A PENDING Priority\n\
+             4 PENDING ReqNodeNotAvail, UnavailableNodes:ghost\n5 PENDING\n",
+        );
+        assert_eq!(q.len(), 5);
         assert_eq!((q[0].task, q[0].state.as_str(), q[0].ended()), (2, "PENDING", false));
+        assert_eq!(q[0].reason.as_deref(), Some("Resources"));
         assert!(q[2].ended());
+        assert_eq!(q[3].reason.as_deref(), Some("ReqNodeNotAvail, UnavailableNodes:ghost"));
+        assert_eq!(q[4].reason, None);
+        let config = "Configuration data as of 2026-12-07T23:01:02\nMaxArraySize            = 8\n\
+                      MaxJobCount             = 10000\n";
+        assert_eq!(config_value(config, "MaxArraySize"), Some("8"));
+        assert_eq!(config_value(config, "MaxArray"), None);
         let s = parse_scontrol(
             "JobId=4 ArrayJobId=1 ArrayTaskId=2 ArrayTaskThrottle=2 JobName=t.sh UserId=root(0) \
              JobState=FAILED Reason=NonZeroExitCode Dependency=(null) ExitCode=7:0\n\
@@ -180,5 +261,51 @@ mod tests {
             (a[1].task, a[1].state.as_str(), a[1].exit_code.as_deref()),
             (1, "CANCELLED", Some("0:15"))
         );
+    }
+
+    #[test]
+    fn slurm_times_in_seconds() {
+        for (time, seconds) in [
+            ("10", Some(600)),
+            ("10:30", Some(630)),
+            ("1:02:03", Some(3723)),
+            ("2-3", Some((2 * 24 + 3) * 3600)),
+            ("2-03:04", Some(((2 * 24 + 3) * 60 + 4) * 60)),
+            ("1-00:00:01", Some(86_401)),
+            ("00:01:00", Some(60)),
+        ] {
+            assert_eq!(parse_time(time), Some(seconds), "{time}");
+        }
+        for unlimited in ["UNLIMITED", "INFINITE", "0"] {
+            assert_eq!(parse_time(unlimited), Some(None), "{unlimited}");
+        }
+        for bad in ["", "abc", "1h", "-5", "1:2:3:4", "1-2:3:4:5", "1--2", "1.5"] {
+            assert_eq!(parse_time(bad), None, "{bad:?}");
+        }
+    }
+
+    #[test]
+    fn reasons_that_never_clear() {
+        for reason in [
+            "PartitionTimeLimit",
+            "QOSMaxWallDurationPerJobLimit",
+            "AssocMaxCpuPerJobLimit",
+            "InvalidAccount",
+            "BadConstraints",
+        ] {
+            assert!(never_starts(reason), "{reason}");
+        }
+        for reason in [
+            "Priority",
+            "Resources",
+            "None",
+            "QOSGrpCpuLimit",
+            "AssocGrpNodeLimit",
+            "QOSMaxJobsPerUserLimit",
+            "PartitionNodeLimit",
+            "ReqNodeNotAvail, UnavailableNodes:ghost",
+        ] {
+            assert!(!never_starts(reason), "{reason}");
+        }
     }
 }

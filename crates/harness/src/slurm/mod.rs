@@ -3,14 +3,18 @@
 //!
 //! [`Cluster::connect`] checks, before anything is submitted, that Slurm's commands are on
 //! `PATH`, that the partition exists, that the `meniscus` binary is of this solver build
-//! (its `--version` carries [`meniscus::SOLVER_FINGERPRINT`]) and that the spool directory
-//! is one the partition's nodes can read. [`Cluster::run`] then writes each run's scene to
-//! the [`spool`], submits one `sbatch --array` per thread count (task k runs one scene
-//! through `meniscus run`), follows the tasks with `squeue` (and `scontrol` / `sacct` for
-//! an ended task's exit code), and collects each finished run's outputs into the record the
-//! local executor would have written. A task that fails, times out or is cancelled is
-//! reported with its Slurm state and exit code and not collected; the next invocation
-//! submits it again, and only it. Ctrl-C cancels the submitted arrays (`scancel`).
+//! (its `--version` carries [`meniscus::SOLVER_FINGERPRINT`]), that the spool directory
+//! is one the partition's nodes can read, and that `--time-limit` is a Slurm time within the
+//! partition's `MaxTime` (beyond it, Slurm would leave the tasks pending for ever).
+//! [`Cluster::run`] then writes each run's scene to the [`spool`], submits one
+//! `sbatch --array` per thread count (task k runs one scene through `meniscus run`; more
+//! runs than the cluster's `MaxArraySize` take several arrays), follows the tasks with
+//! `squeue` (and `scontrol` / `sacct` for an ended task's exit code), and collects each
+//! finished run's outputs into the record the local executor would have written. A task
+//! that fails, times out or is cancelled, or waits for a reason Slurm does not clear by
+//! itself ([`commands::never_starts`]: it is cancelled), is reported with its Slurm state
+//! and not collected; the next invocation submits it again, and only it. Ctrl-C cancels the
+//! submitted arrays (`scancel`).
 
 pub mod commands;
 pub mod spool;
@@ -78,6 +82,8 @@ pub struct Cluster {
     opts: SlurmOptions,
     partition: String,
     spool: Spool,
+    /// The most tasks of one array (the cluster's `MaxArraySize`: indices 0 to it − 1).
+    max_array: usize,
 }
 
 /// How a run submitted to Slurm ended.
@@ -151,14 +157,23 @@ impl Cluster {
             }
             None => partitions.first().cloned().ok_or_else(|| slurm_error("sinfo lists no partition"))?,
         };
+        let partition_line =
+            run("scontrol", &["-o", "show", "partition", &partition]).map_err(slurm_error)?;
+        if let Some(time) = &opts.time_limit {
+            check_time_limit(time, &partition, &partition_line)?;
+        }
+        let config = run("scontrol", &["show", "config"]).map_err(slurm_error)?;
+        // Slurm's default when the configuration does not say.
+        let max_array =
+            commands::config_value(&config, "MaxArraySize").and_then(|v| v.parse().ok()).unwrap_or(1001);
         check_binary(&opts.meniscus)?;
         crate::io::create_dir(&opts.spool)?;
         let spool_path = opts
             .spool
             .canonicalize()
             .map_err(|source| HarnessError::Io { path: opts.spool.clone(), source })?;
-        check_shared(&spool_path, &partition)?;
-        Ok(Cluster { spool: Spool::new(spool_path), opts, partition })
+        check_shared(&spool_path, &partition, &partition_line)?;
+        Ok(Cluster { spool: Spool::new(spool_path), opts, partition, max_array: usize::max(max_array, 1) })
     }
 
     /// Runs `runs` (`(key, spec, threads)`; `threads` `None`: `--cpus-per-task`): each
@@ -201,9 +216,11 @@ impl Cluster {
         FOLLOWING.store(true, Ordering::SeqCst);
         let mut arrays = Vec::new();
         for (threads, tasks) in groups {
-            let array = self.submit(threads, tasks)?;
-            submitted.0.push(array.id);
-            arrays.push(array);
+            for (part, tasks) in tasks.chunks(self.max_array).enumerate() {
+                let array = self.submit(threads, part, tasks.to_vec())?;
+                submitted.0.push(array.id);
+                arrays.push(array);
+            }
         }
         loop {
             if INTERRUPTED.swap(false, Ordering::SeqCst) {
@@ -245,11 +262,12 @@ impl Cluster {
         }
     }
 
-    /// Submits one array of `tasks`, each run on `threads` threads.
-    fn submit<'a>(&self, threads: usize, tasks: Vec<(usize, &'a RunSpec)>) -> Result<Array<'a>> {
+    /// Submits one array of `tasks`, each run on `threads` threads (`part`: its place among
+    /// the arrays of this thread count).
+    fn submit<'a>(&self, threads: usize, part: usize, tasks: Vec<(usize, &'a RunSpec)>) -> Result<Array<'a>> {
         let stamp =
             std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
-        let name = format!("{stamp}-{}-t{threads}", std::process::id());
+        let name = format!("{stamp}-{}-t{threads}-{part}", std::process::id());
         let dirs: Vec<PathBuf> = tasks.iter().map(|(_, spec)| self.spool.run_dir(spec, threads)).collect();
         let dir = self.spool.write_array(&name, &dirs, &self.opts.meniscus, threads)?;
         let mut range = format!("0-{}", tasks.len() - 1);
@@ -337,7 +355,7 @@ impl Array<'_> {
     ) -> Result<Option<(usize, usize)>> {
         let (mut pending, mut running) = (0, 0);
         let id = self.id.to_string();
-        let Ok(out) = run("squeue", &["-h", "-r", "--states=all", "-j", &id, "-o", "%K %T"]) else {
+        let Ok(out) = run("squeue", &["-h", "-r", "--states=all", "-j", &id, "-o", "%K %T %r"]) else {
             return Ok(None);
         };
         let queue = commands::parse_squeue(&out);
@@ -352,6 +370,20 @@ impl Array<'_> {
                 Some(cluster.collect(task.spec, threads))
             } else {
                 match state.get(&k) {
+                    // Waiting for a limit to change: it would never start.
+                    Some(s)
+                        if s.state == "PENDING"
+                            && s.reason.as_deref().is_some_and(commands::never_starts) =>
+                    {
+                        let reason = s.reason.as_deref().unwrap_or_default();
+                        let cancelled = run("scancel", &[&format!("{}_{k}", self.id)])
+                            .map_or_else(|e| format!("not cancelled: {e}"), |_| "cancelled".to_string());
+                        Some(Outcome::Failed(format!(
+                            "Slurm task {}_{k}: pending for a reason Slurm does not clear by itself \
+                             ({reason}); {cancelled}",
+                            self.id
+                        )))
+                    }
                     Some(s) if !s.ended() => {
                         task.since = None;
                         if s.state == "PENDING" {
@@ -473,11 +505,33 @@ fn check_binary(meniscus: &Path) -> Result<()> {
     Ok(())
 }
 
-/// The spool is readable from the partition's nodes: they are all this host, or it lies
-/// on a shared file system ([`SHARED_FILE_SYSTEMS`]).
-fn check_shared(spool: &Path, partition: &str) -> Result<()> {
-    let line = run("scontrol", &["-o", "show", "partition", partition]).map_err(slurm_error)?;
-    let list = commands::field(&line, "Nodes").unwrap_or_default();
+/// `--time-limit` is a Slurm time within the partition's `MaxTime` (from `line`, its
+/// `scontrol -o show partition`): a longer one would leave every task pending
+/// (`PartitionTimeLimit`) unless the cluster refuses it outright.
+fn check_time_limit(time: &str, partition: &str, line: &str) -> Result<()> {
+    let asked = commands::parse_time(time).ok_or_else(|| {
+        slurm_error(format!(
+            "--time-limit: `{time}` is not a Slurm time (minutes, minutes:seconds, \
+             hours:minutes:seconds, days-hours, days-hours:minutes or days-hours:minutes:seconds)"
+        ))
+    })?;
+    let max_time = commands::field(line, "MaxTime").unwrap_or("UNLIMITED");
+    if let Some(Some(max)) = commands::parse_time(max_time)
+        && asked.is_none_or(|asked| asked > max)
+    {
+        return Err(slurm_error(format!(
+            "--time-limit: `{time}` exceeds partition `{partition}`'s MaxTime of {max_time}: Slurm \
+             would leave the tasks pending (PartitionTimeLimit); ask for {max_time} or less"
+        )));
+    }
+    Ok(())
+}
+
+/// The spool is readable from the partition's nodes (`line`: the partition's
+/// `scontrol -o show partition`): they are all this host, or it lies on a shared file
+/// system ([`SHARED_FILE_SYSTEMS`]).
+fn check_shared(spool: &Path, partition: &str, line: &str) -> Result<()> {
+    let list = commands::field(line, "Nodes").unwrap_or_default();
     let nodes: Vec<String> = run("scontrol", &["show", "hostnames", list])
         .map_err(slurm_error)?
         .lines()
