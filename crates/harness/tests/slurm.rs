@@ -9,6 +9,8 @@
 //!   runs split into arrays of the cluster's `MaxArraySize` (8 in the test cluster);
 //! - a task killed mid-run is reported with its Slurm state, left uncached, and submitted
 //!   alone by the next invocation;
+//! - when the submitter is killed (SIGKILL: nothing cancels its arrays), the next invocation
+//!   follows the tasks still queued instead of submitting their runs again;
 //! - tasks that wait for a reason Slurm does not clear by itself (here the partition's
 //!   `MaxTime` lowered below their time limit after the check) are cancelled and reported;
 //! - an unknown partition, a spool on a node-local file system for a partition of other
@@ -219,5 +221,53 @@ fn tasks_that_would_never_start_are_cancelled_and_reported() {
         queued.stdout.is_empty(),
         "the tasks were cancelled: {}",
         String::from_utf8_lossy(&queued.stdout)
+    );
+}
+
+#[test]
+#[ignore = "needs a Slurm cluster: tools/slurm-test/run.sh"]
+fn a_killed_submitters_tasks_are_followed_not_submitted_again() {
+    // The submitter to be killed: this test's binary again, running only the sweep.
+    if let Some(dir) = std::env::var_os("MENISCUS_SLURM_SUBMITTER") {
+        let _ = validate(&on_slurm(Path::new(&dir)));
+        return;
+    }
+    let dir = workspace("adopted", true);
+    let spool = dir.join("spool");
+    let mut submitter = std::process::Command::new(std::env::current_exe().expect("the test binary"))
+        .args(["--exact", "a_killed_submitters_tasks_are_followed_not_submitted_again", "--ignored"])
+        .env("MENISCUS_SLURM_SUBMITTER", &dir)
+        .stdout(std::process::Stdio::null())
+        .spawn()
+        .expect("the submitter starts");
+    let start = Instant::now();
+    let long = loop {
+        assert!(start.elapsed() < Duration::from_secs(120), "the long run never started");
+        if let Some(task) = running_long_task(&spool) {
+            break task;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    submitter.kill().expect("SIGKILL the submitter");
+    let _ = submitter.wait();
+    let arrays = || std::fs::read_dir(spool.join("arrays")).expect("the spool's arrays").count();
+    let submitted = arrays();
+    let queued = |task: &str| {
+        let out = std::process::Command::new("squeue").args(["-h", "-j", task]).output().expect("squeue");
+        !out.stdout.is_empty()
+    };
+    assert!(queued(&long), "the long run's task {long} outlives its submitter");
+
+    let outcome = validate(&on_slurm(&dir)).expect("the next sweep");
+    assert_eq!(arrays(), submitted, "nothing was submitted again");
+    let runs = &outcome.results[0].runs;
+    assert!(
+        runs.iter().all(|r| !r.status.starts_with("failed")),
+        "{:?}",
+        runs.iter().map(|r| &r.status).collect::<Vec<_>>()
+    );
+    assert!(
+        dir.join("reports/elliptical_drop/runs/isph-long_dx0.02.json").exists(),
+        "the long run was collected"
     );
 }

@@ -125,16 +125,28 @@ pub fn never_starts(reason: &str) -> bool {
 /// state, reason); lines without a single task index (a pending range such as `3-9%2` is
 /// expanded by `-r`) are skipped.
 pub fn parse_squeue(squeue: &str) -> Vec<TaskState> {
+    squeue.lines().filter_map(|l| squeue_task(l.split_whitespace())).collect()
+}
+
+/// The tasks of `squeue -h -r --states=all -j <job>,<job>… -o "%F %K %T %r"`: (array job
+/// id, task) pairs, as [`parse_squeue`].
+pub fn parse_squeue_jobs(squeue: &str) -> Vec<(u64, TaskState)> {
     squeue
         .lines()
         .filter_map(|l| {
             let mut f = l.split_whitespace();
-            let task = f.next()?.parse().ok()?;
-            let state = f.next()?.to_string();
-            let reason = f.collect::<Vec<_>>().join(" ");
-            Some(TaskState { task, state, exit_code: None, reason: (!reason.is_empty()).then_some(reason) })
+            let job = f.next()?.parse().ok()?;
+            Some((job, squeue_task(f)?))
         })
         .collect()
+}
+
+/// A task from its `squeue` fields: index, state, reason (the rest of the line).
+fn squeue_task<'a>(mut f: impl Iterator<Item = &'a str>) -> Option<TaskState> {
+    let task = f.next()?.parse().ok()?;
+    let state = f.next()?.to_string();
+    let reason = f.collect::<Vec<_>>().join(" ");
+    Some(TaskState { task, state, exit_code: None, reason: (!reason.is_empty()).then_some(reason) })
 }
 
 /// A Slurm time (`sbatch --time`, a partition's `MaxTime`) in seconds, `Some(None)` when
@@ -243,6 +255,9 @@ mod tests {
         assert!(q[2].ended());
         assert_eq!(q[3].reason.as_deref(), Some("ReqNodeNotAvail, UnavailableNodes:ghost"));
         assert_eq!(q[4].reason, None);
+        let jobs = parse_squeue_jobs("7 0 RUNNING None\n9 3 PENDING Priority\nN/A 1 PENDING None\n");
+        assert_eq!(jobs.len(), 2);
+        assert_eq!((jobs[1].0, jobs[1].1.task, jobs[1].1.state.as_str()), (9, 3, "PENDING"));
         let config = "Configuration data as of 2026-12-07T23:01:02\nMaxArraySize            = 8\n\
                       MaxJobCount             = 10000\n";
         assert_eq!(config_value(config, "MaxArraySize"), Some("8"));

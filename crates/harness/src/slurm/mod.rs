@@ -13,8 +13,9 @@
 //! finished run's outputs into the record the local executor would have written. A task
 //! that fails, times out or is cancelled, or waits for a reason Slurm does not clear by
 //! itself ([`commands::never_starts`]: it is cancelled), is reported with its Slurm state
-//! and not collected; the next invocation submits it again, and only it. Ctrl-C cancels the
-//! submitted arrays (`scancel`).
+//! and not collected; the next invocation submits it again, and only it. A run whose task
+//! from an earlier invocation (its submitter killed) still pends or runs is followed, not
+//! submitted again. Ctrl-C cancels the submitted arrays (`scancel`).
 
 pub mod commands;
 pub mod spool;
@@ -189,6 +190,9 @@ impl Cluster {
         report: &mut dyn FnMut(usize, Outcome) -> Result<()>,
     ) -> Result<()> {
         let mut counts = Counts::default();
+        // Tasks of earlier invocations still queued, by (job, task index): followed again.
+        let live = if rerun { BTreeMap::new() } else { self.live_claims(runs) };
+        let mut adopted: BTreeMap<u64, Array> = BTreeMap::new();
         // Arrays to submit: threads → runs.
         let mut groups: BTreeMap<usize, Vec<(usize, &RunSpec)>> = BTreeMap::new();
         for &(key, spec, threads) in runs {
@@ -203,28 +207,45 @@ impl Cluster {
                 counts.done += 1;
                 continue;
             }
+            if let Some(claim) =
+                self.spool.claimed(spec, threads).filter(|c| live.contains_key(&(c.job, c.task)))
+            {
+                let array = adopted.entry(claim.job).or_insert_with(|| Array {
+                    id: claim.job,
+                    dir: claim.array.clone(),
+                    threads,
+                    tasks: Vec::new(),
+                });
+                array.tasks.push(Task { index: claim.task, key, spec, ended: false, since: None });
+                continue;
+            }
             self.spool.prepare(spec, threads)?;
             groups.entry(threads).or_default().push((key, spec));
         }
-        if groups.is_empty() {
+        if groups.is_empty() && adopted.is_empty() {
             return Ok(());
         }
         install_interrupt_handler();
         INTERRUPTED.store(false, Ordering::SeqCst);
-        // Cancels what was submitted on any early return (an error, an interruption).
+        // Cancels what is followed on any early return (an error, an interruption): the
+        // arrays submitted here, the adopted tasks one by one (their arrays may hold runs of
+        // other invocations).
         let mut submitted = Submitted::default();
         FOLLOWING.store(true, Ordering::SeqCst);
-        let mut arrays = Vec::new();
+        let mut arrays: Vec<Array> = adopted.into_values().collect();
+        for array in &arrays {
+            submitted.0.extend(array.tasks.iter().map(|t| format!("{}_{}", array.id, t.index)));
+        }
         for (threads, tasks) in groups {
             for (part, tasks) in tasks.chunks(self.max_array).enumerate() {
                 let array = self.submit(threads, part, tasks.to_vec())?;
-                submitted.0.push(array.id);
+                submitted.0.push(array.id.to_string());
                 arrays.push(array);
             }
         }
         loop {
             if INTERRUPTED.swap(false, Ordering::SeqCst) {
-                let ids: Vec<String> = submitted.0.iter().map(u64::to_string).collect();
+                let ids = submitted.0.clone();
                 let cancelled = submitted.cancel();
                 return Err(slurm_error(format!(
                     "interrupted: Slurm job(s) {} {}; runs that finished are kept, run the command \
@@ -295,13 +316,45 @@ impl Cluster {
         let id = commands::parse_job_id(&out)
             .ok_or_else(|| slurm_error(format!("sbatch printed no job id: `{}`", out.trim())))?;
         crate::io::write_atomic(&dir.join("job_id"), format!("{id}\n").as_bytes())?;
-        let tasks =
-            tasks.into_iter().map(|(key, spec)| Task { key, spec, ended: false, since: None }).collect();
+        for (k, run_dir) in dirs.iter().enumerate() {
+            self.spool.claim(run_dir, id, k, &dir)?;
+        }
+        let tasks = tasks
+            .into_iter()
+            .enumerate()
+            .map(|(index, (key, spec))| Task { index, key, spec, ended: false, since: None })
+            .collect();
         Ok(Array { id, dir, threads, tasks })
+    }
+
+    /// The array tasks that took `runs` in earlier invocations and are still pending or
+    /// running, by (job, task index) (one `squeue` for all their jobs; none when it fails).
+    fn live_claims(&self, runs: &[(usize, &RunSpec, Option<usize>)]) -> BTreeMap<(u64, usize), TaskState> {
+        let jobs: std::collections::BTreeSet<u64> = runs
+            .iter()
+            .filter_map(|&(_, spec, threads)| {
+                self.spool.claimed(spec, threads.unwrap_or(self.opts.cpus_per_task)).map(|c| c.job)
+            })
+            .collect();
+        if jobs.is_empty() {
+            return BTreeMap::new();
+        }
+        let list: Vec<String> = jobs.iter().map(u64::to_string).collect();
+        let Ok(out) =
+            run("squeue", &["-h", "-r", "--states=all", "-j", &list.join(","), "-o", "%F %K %T %r"])
+        else {
+            return BTreeMap::new();
+        };
+        commands::parse_squeue_jobs(&out)
+            .into_iter()
+            .filter(|(_, s)| !s.ended())
+            .map(|(job, s)| ((job, s.task), s))
+            .collect()
     }
 }
 
-/// One submitted array and its tasks (task k is `tasks[k]`).
+/// One array and the tasks of it that are followed: all of an array submitted here, the
+/// still-queued ones of an array adopted from an earlier invocation.
 struct Array<'a> {
     id: u64,
     dir: PathBuf,
@@ -309,17 +362,18 @@ struct Array<'a> {
     tasks: Vec<Task<'a>>,
 }
 
-/// The job ids submitted by one [`Cluster::run`], cancelled when dropped unless cleared.
+/// The Slurm ids (`<job>` or `<job>_<task>`) followed by one [`Cluster::run`], cancelled
+/// when dropped unless cleared.
 #[derive(Default)]
-struct Submitted(Vec<u64>);
+struct Submitted(Vec<String>);
 
 impl Submitted {
-    /// `scancel` of every submitted job; nothing is left to cancel after it.
+    /// `scancel` of every followed job or task; nothing is left to cancel after it.
     fn cancel(&mut self) -> std::result::Result<(), commands::CommandError> {
         if self.0.is_empty() {
             return Ok(());
         }
-        let ids: Vec<String> = self.0.drain(..).map(|id| id.to_string()).collect();
+        let ids: Vec<String> = self.0.drain(..).collect();
         run("scancel", &ids.iter().map(String::as_str).collect::<Vec<_>>()).map(|_| ())
     }
 }
@@ -334,6 +388,8 @@ impl Drop for Submitted {
 
 /// A task of an array.
 struct Task<'a> {
+    /// Its index in the array (`SLURM_ARRAY_TASK_ID`).
+    index: usize,
     key: usize,
     spec: &'a RunSpec,
     /// Reported (finished or failed).
@@ -361,8 +417,9 @@ impl Array<'_> {
         let queue = commands::parse_squeue(&out);
         let threads = self.threads;
         let state: BTreeMap<usize, TaskState> = queue.into_iter().map(|s| (s.task, s)).collect();
-        for k in 0..self.tasks.len() {
-            let task = &mut self.tasks[k];
+        for i in 0..self.tasks.len() {
+            let task = &mut self.tasks[i];
+            let k = task.index;
             if task.ended {
                 continue;
             }
@@ -420,7 +477,7 @@ impl Array<'_> {
                 }
             };
             if let Some(outcome) = outcome {
-                let task = &mut self.tasks[k];
+                let task = &mut self.tasks[i];
                 task.ended = true;
                 match &outcome {
                     Outcome::Finished(_) => counts.done += 1,

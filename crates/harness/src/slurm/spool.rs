@@ -3,9 +3,11 @@
 //! - `runs/<scene hash>-t<threads>/scene.json`: a run's effective scene (the thread count
 //!   in the name: the work-precision study runs one scene on several); `out/` once its task has
 //!   finished (the `meniscus run` outputs, `summary.json`, `probes.json`, `snapshots/`,
-//!   and `cpu.txt`, the task's CPU time), `out.partial/` while it runs. The directory is
+//!   and `cpu.txt`, the task's CPU time), `out.partial/` while it runs; `task`, the array
+//!   task that last took it (`<job> <task index> <array directory>`). The directory is
 //!   keyed by the run's hash, so a run that finished after its submitter was stopped is
-//!   collected by the next invocation instead of run again;
+//!   collected by the next invocation instead of run again, and one whose task still
+//!   pends or runs is followed instead of submitted again;
 //! - `arrays/<name>/`: one submitted job array: `run.sh` (the batch script), `tasks.txt`
 //!   (task k runs the run directory on line k + 1), `task_<k>.log` (each task's output),
 //!   `job_id`.
@@ -41,6 +43,18 @@ impl Spool {
         let dir = self.run_dir(spec, threads);
         let _ = std::fs::read_dir(&dir).map(|entries| entries.count());
         dir.join("out").join("summary.json").is_file()
+    }
+
+    /// Records that array task `task` of job `job` (its directory `array`) took the run.
+    pub fn claim(&self, run_dir: &Path, job: u64, task: usize, array: &Path) -> Result<()> {
+        io::write_atomic(&run_dir.join("task"), format!("{job} {task} {}\n", array.display()).as_bytes())
+    }
+
+    /// The array task that last took the run (see [`Spool::claim`]), if any.
+    pub fn claimed(&self, spec: &RunSpec, threads: usize) -> Option<Claim> {
+        let text = std::fs::read_to_string(self.run_dir(spec, threads).join("task")).ok()?;
+        let mut f = text.trim_end_matches('\n').splitn(3, ' ');
+        Some(Claim { job: f.next()?.parse().ok()?, task: f.next()?.parse().ok()?, array: f.next()?.into() })
     }
 
     /// Writes the run's scene for a task, dropping the outputs of an earlier one.
@@ -96,6 +110,17 @@ impl Spool {
         io::write_atomic(&dir.join("run.sh"), script.as_bytes())?;
         Ok(dir)
     }
+}
+
+/// An array task that took a run (see [`Spool::claim`]).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Claim {
+    /// The array's job id.
+    pub job: u64,
+    /// The task's index in the array.
+    pub task: usize,
+    /// The array's directory (`arrays/<name>/`).
+    pub array: PathBuf,
 }
 
 /// The batch script of an array: task k runs the scene of the run directory on line k + 1
