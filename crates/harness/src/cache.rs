@@ -115,6 +115,17 @@ pub fn load(path: &Path, scene_hash: &str) -> Option<RunRecord> {
     (record.completed && record.scene_hash == scene_hash).then_some(record)
 }
 
+/// Whether [`load`] would reuse the record at `path`: it reads the file but keeps only the
+/// two fields checked (the runner asks this of every job before it runs any).
+pub fn is_cached(path: &Path, scene_hash: &str) -> bool {
+    #[derive(Deserialize)]
+    struct Head {
+        completed: bool,
+        scene_hash: String,
+    }
+    io::read_json::<Head>(path).is_ok_and(|h| h.completed && h.scene_hash == scene_hash)
+}
+
 /// Stores a record atomically.
 pub fn store(path: &Path, record: &RunRecord) -> Result<()> {
     io::write_json(path, record)

@@ -9,8 +9,8 @@
 //!   (counted, never cached), and the other jobs go on;
 //! - starts the costliest jobs first ([`Job::cost`], an estimate), so that no long run
 //!   starts last while the other workers idle;
-//! - runs a *wide* job (one asking for every thread of the machine) alone, before the
-//!   others; the others `jobs` at a time, each worker with its own rayon pool of an equal
+//! - runs a *wide* job (one asking for every thread of the machine, or allowed them and
+//!   the batch's critical path: [`Job::wide`]) alone, before the others; the others `jobs` at a time, each worker with its own rayon pool of an equal
 //!   share of the threads (a second thread speeds a run 1.5–1.8 times, a second run at once
 //!   doubles the throughput: docs/notes/main-job-time.md); a job may ask for its own thread
 //!   count instead (the work-precision study's thread counts);
@@ -45,6 +45,11 @@ pub struct Job {
     /// Threads of the run's own rayon pool; `None`: the worker's share of the machine (all
     /// of the global pool when one job runs at a time).
     pub threads: Option<usize>,
+    /// May take every thread of the machine (running alone, first) when it is the batch's
+    /// critical path: when its cost exceeds the summed cost of the batch's jobs that are
+    /// not cached over the runner's workers. Otherwise it runs on a worker's share, like
+    /// any job with `threads` `None`.
+    pub wide: bool,
     /// Estimated cost (any unit shared by the batch, e.g. core-seconds): the costliest jobs
     /// start first and the batch's bar measures progress in it; 0 when unknown (such jobs
     /// keep their order, after the costed ones, and the bar counts each as one unit).
@@ -54,7 +59,7 @@ pub struct Job {
 impl Job {
     /// A job on the worker's share of the threads, of unknown cost.
     pub fn new(spec: RunSpec) -> Self {
-        Job { spec, threads: None, cost: 0.0 }
+        Job { spec, threads: None, wide: false, cost: 0.0 }
     }
 }
 
@@ -208,8 +213,19 @@ impl Runner {
         // Costliest first (a stable sort: jobs of unknown cost keep their order, last).
         let mut order: Vec<usize> = (0..jobs.len()).collect();
         order.sort_by(|&a, &b| jobs[b].1.cost.total_cmp(&jobs[a].1.cost));
-        let (wide, narrow): (Vec<usize>, Vec<usize>) =
-            order.into_iter().partition(|&i| self.jobs > 1 && jobs[i].1.threads.is_some_and(|k| k >= all));
+        // What the batch will run (a cached job costs nothing): a `wide` job is its critical
+        // path when it alone costs more than a worker's share of that.
+        let to_run: f64 = jobs
+            .iter()
+            .filter(|(dir, j)| {
+                self.force || !cache::is_cached(&cache::record_path(dir, &j.spec.slug), &j.spec.hash)
+            })
+            .map(|(_, j)| j.cost)
+            .sum();
+        let critical = |j: &Job| j.wide && j.cost * self.jobs as f64 > to_run;
+        let (wide, narrow): (Vec<usize>, Vec<usize>) = order.into_iter().partition(|&i| {
+            self.jobs > 1 && (jobs[i].1.threads.is_some_and(|k| k >= all) || critical(jobs[i].1))
+        });
         let phase = |queue: &[usize], workers: usize| {
             let next = AtomicUsize::new(0);
             let share = (workers > 1).then(|| (all / workers).max(1));
@@ -488,6 +504,45 @@ mod tests {
                 assert_eq!(finished[0], "wide", "the wide job runs alone, first: {finished:?}");
             }
         }
+    }
+
+    /// A `wide` job takes every thread only when it is the critical path of what the batch
+    /// runs: its cost above the uncached jobs' summed cost over the workers.
+    #[test]
+    fn wide_jobs_take_every_thread_only_on_the_critical_path() {
+        let mut case = crate::case::testing::committed("elliptical_drop");
+        case.scene["time"]["end"] = serde_json::json!(2e-4);
+        let job = |name: &str, cost: f64, wide: bool| {
+            let mut spec = crate::sweep::spec(&case, "paper", 0.1).unwrap();
+            spec.slug = name.into();
+            Job { wide, cost, ..Job::new(spec) }
+        };
+        let dir = Scratch::new("runner-wide");
+        let pool = rayon::ThreadPoolBuilder::new().num_threads(2).build().unwrap();
+        pool.install(|| {
+            let threads = |force: bool, jobs: &[Job]| -> Vec<usize> {
+                Runner::new(Progress::silent(), force, 2)
+                    .run(dir.path(), None, jobs, |_, ran| {
+                        Ok((ran.record().unwrap().threads.unwrap(), String::new()))
+                    })
+                    .unwrap()
+            };
+            // 5 > (5 + 1 + 1) / 2: the big run is the critical path.
+            assert_eq!(
+                threads(true, &[job("big", 5.0, true), job("a", 1.0, false), job("b", 1.0, false)]),
+                [2, 1, 1]
+            );
+            // 3 < (3 + 2 + 2) / 2: it is not, and runs on a worker's share.
+            assert_eq!(
+                threads(true, &[job("big", 3.0, true), job("a", 2.0, false), job("b", 2.0, false)]),
+                [1, 1, 1]
+            );
+            // The same batch with `a` and `b` cached: the new big run is all that runs.
+            assert_eq!(
+                threads(false, &[job("big2", 3.0, true), job("a", 2.0, false), job("b", 2.0, false)]),
+                [2, 1, 1]
+            );
+        });
     }
 
     /// Two tiny drops (dx = 0.1, 10 steps), one of which panics: the panic is that job's

@@ -108,8 +108,8 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
                     let unperturbed = crate::results::slug(&spec.scheme, &spec.preset, spec.dx);
                     let previous = measured.get(&spec.slug).or_else(|| measured.get(&unperturbed)).copied();
                     let job = plan(spec, previous);
-                    // The wide-run thread count is this machine's: on Slurm, --cpus-per-task.
-                    if opts.slurm.is_some() { Job { threads: None, ..job } } else { job }
+                    // Wide runs take this machine's threads: on Slurm, --cpus-per-task.
+                    if opts.slurm.is_some() { Job { wide: false, ..job } } else { job }
                 })
                 .collect();
             Ok((dir, jobs))
@@ -192,19 +192,21 @@ pub fn extra_pages(out: &Path) -> Vec<report::ExtraPage> {
     crate::stability::extra_page(out).into_iter().chain(crate::work_precision::extra_page(out)).collect()
 }
 
-/// Runs with at least this many particles get every thread of the machine (and run alone,
-/// first); smaller ones one worker's share. Measured on the 2-core machine
+/// Runs with at least this many particles may get every thread of the machine (and run
+/// alone, first) when they are the batch's critical path ([`crate::runner::Job::wide`]);
+/// other runs get one worker's share. Measured on the 2-core machine
 /// (docs/notes/main-job-time.md): a second thread speeds one run up 1.5–1.8 times (3200 to
 /// 96 000 particles), two one-thread runs at once give 2.0–2.2 times the throughput; so
-/// one thread per run wins, except for a run long enough to be the batch's critical path —
-/// the open channel at Δx = 0.0025 (96 000 particles), not the next largest (37 500).
+/// one thread per run wins, except for a run long enough to be the batch's critical path:
+/// the open channel at Δx = 0.0025 (96 000 particles) when its case runs alone, not beside
+/// the whole default tier.
 pub const WIDE_PARTICLES: usize = 50_000;
 
 /// Estimated cost of one particle-step \[core-s\] (the paper drop at Δx = 0.02: about
 /// 1.5 core-µs): scales the estimate of [`plan`] to core-seconds when no run measured it.
 const CORE_S_PER_PARTICLE_STEP: f64 = 1.5e-6;
 
-/// The job of a run: its thread count from its particle count ([`WIDE_PARTICLES`]) and its
+/// The job of a run: whether it may run wide, from its particle count ([`WIDE_PARTICLES`]), and its
 /// cost in core-seconds: `previous`, the same run's measured cost when the case's last
 /// results have it; otherwise `particles × end / Δt₀ × 1.5 core-µs` with the first step's
 /// Δt (built from the scene before anything runs; a scene that cannot start is costed as
@@ -216,12 +218,12 @@ fn plan(spec: RunSpec, previous: Option<f64>) -> Job {
         return Job::new(spec);
     };
     let particles = sim.particles();
-    let threads = (particles >= WIDE_PARTICLES).then(rayon::current_num_threads);
+    let wide = particles >= WIDE_PARTICLES;
     let cost = previous.unwrap_or_else(|| {
         let steps = sim.first_step().map_or(0.0, |dt| (spec.scene.time.end / dt).ceil());
         particles as f64 * steps * CORE_S_PER_PARTICLE_STEP
     });
-    Job { threads, cost, ..Job::new(spec) }
+    Job { wide, cost, ..Job::new(spec) }
 }
 
 /// The core-seconds each run of a case took when it last ran, by slug, from the case's
