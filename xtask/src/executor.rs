@@ -36,7 +36,8 @@ pub struct ExecutorArgs {
     /// CPUs (threads) of each task.
     #[arg(long, value_name = "N", default_value_t = 1)]
     cpus_per_task: usize,
-    /// Most tasks of an array running at once [default: as many as Slurm allows].
+    /// Most tasks of an array running at once (per array: a sweep of more runs than the
+    /// cluster's MaxArraySize takes several) [default: as many as Slurm allows].
     #[arg(long, value_name = "N")]
     max_tasks: Option<usize>,
     /// Spool directory, on a file system the compute nodes share [default:

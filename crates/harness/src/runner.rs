@@ -45,10 +45,11 @@ pub struct Job {
     /// Threads of the run's own rayon pool; `None`: the worker's share of the machine (all
     /// of the global pool when one job runs at a time).
     pub threads: Option<usize>,
-    /// May take every thread of the machine (running alone, first) when it is the batch's
-    /// critical path: when its cost exceeds the summed cost of the batch's jobs that are
-    /// not cached over the runner's workers. Otherwise it runs on a worker's share, like
-    /// any job with `threads` `None`.
+    /// May take every thread of the machine (running alone, first) when that ends the batch
+    /// sooner: for the costliest such job of cost `c` among the batch's uncached jobs of
+    /// summed cost `T`, on `W` workers, when `c (1 − 1/s) > (T − c) / W` with `s` the
+    /// speed-up of every thread ([`wide_speedup`]); with two threads, when it is over 60 %
+    /// of `T`. Otherwise it runs on a worker's share, like any job with `threads` `None`.
     pub wide: bool,
     /// Estimated cost (any unit shared by the batch, e.g. core-seconds): the costliest jobs
     /// start first and the batch's bar measures progress in it; 0 when unknown (such jobs
@@ -213,18 +214,27 @@ impl Runner {
         // Costliest first (a stable sort: jobs of unknown cost keep their order, last).
         let mut order: Vec<usize> = (0..jobs.len()).collect();
         order.sort_by(|&a, &b| jobs[b].1.cost.total_cmp(&jobs[a].1.cost));
-        // What the batch will run (a cached job costs nothing): a `wide` job is its critical
-        // path when it alone costs more than a worker's share of that.
-        let to_run: f64 = jobs
-            .iter()
-            .filter(|(dir, j)| {
+        // What the batch will run (a cached job costs nothing), and the one `wide` job that
+        // ends it sooner alone on every thread than on a worker's share (see `Job::wide`).
+        let uncached: Vec<usize> = (0..jobs.len())
+            .filter(|&i| {
+                let (dir, j) = jobs[i];
                 self.force || !cache::is_cached(&cache::record_path(dir, &j.spec.slug), &j.spec.hash)
             })
-            .map(|(_, j)| j.cost)
-            .sum();
-        let critical = |j: &Job| j.wide && j.cost * self.jobs as f64 > to_run;
+            .collect();
+        let to_run: f64 = uncached.iter().map(|&i| jobs[i].1.cost).sum();
+        let workers = self.jobs.min(all).max(1) as f64;
+        let critical = uncached
+            .iter()
+            .copied()
+            .filter(|&i| jobs[i].1.wide)
+            .max_by(|&a, &b| jobs[a].1.cost.total_cmp(&jobs[b].1.cost))
+            .filter(|&i| {
+                let c = jobs[i].1.cost;
+                c * (1.0 - 1.0 / wide_speedup(all)) > (to_run - c) / workers
+            });
         let (wide, narrow): (Vec<usize>, Vec<usize>) = order.into_iter().partition(|&i| {
-            self.jobs > 1 && (jobs[i].1.threads.is_some_and(|k| k >= all) || critical(jobs[i].1))
+            self.jobs > 1 && (jobs[i].1.threads.is_some_and(|k| k >= all) || critical == Some(i))
         });
         let phase = |queue: &[usize], workers: usize| {
             let next = AtomicUsize::new(0);
@@ -425,6 +435,13 @@ impl Runner {
     }
 }
 
+/// The assumed speed-up of one run on `threads` threads over one: each thread past the
+/// first adds half a core, as measured for the open channel at Δx = 0.0025 (96 000
+/// particles) on two (1.50; 1.5–1.8 for 3200–37 500 particles, docs/notes/main-job-time.md).
+fn wide_speedup(threads: usize) -> f64 {
+    1.0 + 0.5 * threads.saturating_sub(1) as f64
+}
+
 /// Units of a job of estimated `cost` on the batch's bar (milliseconds of the estimate; one
 /// unit when unknown).
 fn bar_units(cost: f64) -> u64 {
@@ -506,8 +523,7 @@ mod tests {
         }
     }
 
-    /// A `wide` job takes every thread only when it is the critical path of what the batch
-    /// runs: its cost above the uncached jobs' summed cost over the workers.
+    /// A `wide` job takes every thread only when that ends what the batch runs sooner.
     #[test]
     fn wide_jobs_take_every_thread_only_on_the_critical_path() {
         let mut case = crate::case::testing::committed("elliptical_drop");
@@ -527,16 +543,19 @@ mod tests {
                     })
                     .unwrap()
             };
-            // 5 > (5 + 1 + 1) / 2: the big run is the critical path.
+            // 5 (1 − 1/1.5) > (1 + 1) / 2: alone on both threads, the big run ends sooner.
             assert_eq!(
                 threads(true, &[job("big", 5.0, true), job("a", 1.0, false), job("b", 1.0, false)]),
                 [2, 1, 1]
             );
-            // 3 < (3 + 2 + 2) / 2: it is not, and runs on a worker's share.
+            // 3 (1 − 1/1.5) < (2 + 2) / 2: it does not, and runs on a worker's share.
             assert_eq!(
                 threads(true, &[job("big", 3.0, true), job("a", 2.0, false), job("b", 2.0, false)]),
                 [1, 1, 1]
             );
+            // 5.5 of 10 (over half, under 60 %): still not.
+            let batch = [job("big3", 5.5, true), job("c", 2.25, false), job("d", 2.25, false)];
+            assert_eq!(threads(true, &batch), [1, 1, 1]);
             // The same batch with `a` and `b` cached: the new big run is all that runs.
             assert_eq!(
                 threads(false, &[job("big2", 3.0, true), job("a", 2.0, false), job("b", 2.0, false)]),

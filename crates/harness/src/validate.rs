@@ -107,9 +107,7 @@ pub fn validate(opts: &ValidateOptions) -> Result<Outcome> {
                     // A perturbed start costs what its unperturbed run cost.
                     let unperturbed = crate::results::slug(&spec.scheme, &spec.preset, spec.dx);
                     let previous = measured.get(&spec.slug).or_else(|| measured.get(&unperturbed)).copied();
-                    let job = plan(spec, previous);
-                    // Wide runs take this machine's threads: on Slurm, --cpus-per-task.
-                    if opts.slurm.is_some() { Job { wide: false, ..job } } else { job }
+                    plan(spec, previous)
                 })
                 .collect();
             Ok((dir, jobs))

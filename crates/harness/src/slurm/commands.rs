@@ -100,7 +100,8 @@ impl TaskState {
 }
 
 /// Whether a pending task's `reason` is one that Slurm does not clear by itself: the request
-/// exceeds a limit of the partition, the QOS or the association *per job*, or names an
+/// exceeds a limit of the partition, the QOS or the association *per job* (or is below the
+/// QOS's minimum), or names an
 /// account, QOS or constraint that is not allowed (Slurm's job reason codes). Such a task
 /// would wait until an administrator changes the limits; waits on other jobs (`Priority`,
 /// `Resources`, `QOSGrp*`, `AssocGrp*`, `Max*PerUser`, …) or on nodes coming back are not
@@ -108,7 +109,10 @@ impl TaskState {
 pub fn never_starts(reason: &str) -> bool {
     let per_job_limit =
         (reason.starts_with("QOSMax") || reason.starts_with("AssocMax")) && reason.contains("PerJob");
+    // The request is below the QOS's per-job minimum (`QOSMinCpuNotSatisfied`, …).
+    let below_minimum = reason.starts_with("QOSMin");
     per_job_limit
+        || below_minimum
         || matches!(
             reason,
             "PartitionTimeLimit"
@@ -125,37 +129,43 @@ pub fn never_starts(reason: &str) -> bool {
 /// state, reason); lines without a single task index (a pending range such as `3-9%2` is
 /// expanded by `-r`) are skipped.
 pub fn parse_squeue(squeue: &str) -> Vec<TaskState> {
-    squeue.lines().filter_map(|l| squeue_task(l.split_whitespace())).collect()
-}
-
-/// The tasks of `squeue -h -r --states=all -j <job>,<job>… -o "%F %K %T %r"`: (array job
-/// id, task) pairs, as [`parse_squeue`].
-pub fn parse_squeue_jobs(squeue: &str) -> Vec<(u64, TaskState)> {
     squeue
         .lines()
         .filter_map(|l| {
             let mut f = l.split_whitespace();
-            let job = f.next()?.parse().ok()?;
-            Some((job, squeue_task(f)?))
+            let task = f.next()?.parse().ok()?;
+            let state = f.next()?.to_string();
+            let reason = f.collect::<Vec<_>>().join(" ");
+            Some(TaskState { task, state, exit_code: None, reason: (!reason.is_empty()).then_some(reason) })
         })
         .collect()
 }
 
-/// A task from its `squeue` fields: index, state, reason (the rest of the line).
-fn squeue_task<'a>(mut f: impl Iterator<Item = &'a str>) -> Option<TaskState> {
-    let task = f.next()?.parse().ok()?;
-    let state = f.next()?.to_string();
-    let reason = f.collect::<Vec<_>>().join(" ");
-    Some(TaskState { task, state, exit_code: None, reason: (!reason.is_empty()).then_some(reason) })
+/// The tasks of `squeue -h -r --states=all -j <job>,<job>… -o "%F %K %T %o"`: array job
+/// id, task (index and state) and the batch script it runs (the rest of the line: a path
+/// may hold spaces).
+pub fn parse_squeue_jobs(squeue: &str) -> Vec<(u64, TaskState, String)> {
+    squeue
+        .lines()
+        .filter_map(|l| {
+            let mut f = l.splitn(4, ' ');
+            let job = f.next()?.parse().ok()?;
+            let task = f.next()?.parse().ok()?;
+            let state = f.next()?.to_string();
+            let script = f.next()?.trim().to_string();
+            Some((job, TaskState { task, state, exit_code: None, reason: None }, script))
+        })
+        .collect()
 }
 
 /// A Slurm time (`sbatch --time`, a partition's `MaxTime`) in seconds, `Some(None)` when
-/// unlimited (`UNLIMITED`, `INFINITE`, or 0, which asks for no limit); `None` when `time`
-/// is none of Slurm's formats: `minutes`, `minutes:seconds`, `hours:minutes:seconds`,
-/// `days-hours`, `days-hours:minutes`, `days-hours:minutes:seconds`.
+/// unlimited (`UNLIMITED`, `INFINITE` in any case, or `-1`); `None` when `time` is none of
+/// Slurm's formats: `minutes`, `minutes:seconds`, `hours:minutes:seconds`, `days-hours`,
+/// `days-hours:minutes`, `days-hours:minutes:seconds`. Zero is zero here: `sbatch --time=0`
+/// asks for no limit, a partition's `MaxTime` of 0 allows none.
 pub fn parse_time(time: &str) -> Option<Option<u64>> {
     let time = time.trim();
-    if matches!(time, "UNLIMITED" | "INFINITE" | "infinite" | "unlimited") {
+    if time.eq_ignore_ascii_case("unlimited") || time.eq_ignore_ascii_case("infinite") || time == "-1" {
         return Some(None);
     }
     let number = |s: &str| -> Option<u64> {
@@ -182,7 +192,7 @@ pub fn parse_time(time: &str) -> Option<Option<u64>> {
             }
         }
     };
-    Some((seconds > 0).then_some(seconds))
+    Some(Some(seconds))
 }
 
 /// The value of `key` in `scontrol show config` (`Key = value` lines).
@@ -255,9 +265,12 @@ mod tests {
         assert!(q[2].ended());
         assert_eq!(q[3].reason.as_deref(), Some("ReqNodeNotAvail, UnavailableNodes:ghost"));
         assert_eq!(q[4].reason, None);
-        let jobs = parse_squeue_jobs("7 0 RUNNING None\n9 3 PENDING Priority\nN/A 1 PENDING None\n");
+        let jobs = parse_squeue_jobs(
+            "7 0 RUNNING /s/arrays/a/run.sh\n9 3 PENDING /s p/arrays/b/run.sh\nN/A 1 PENDING x\n",
+        );
         assert_eq!(jobs.len(), 2);
         assert_eq!((jobs[1].0, jobs[1].1.task, jobs[1].1.state.as_str()), (9, 3, "PENDING"));
+        assert_eq!(jobs[1].2, "/s p/arrays/b/run.sh");
         let config = "Configuration data as of 2026-12-07T23:01:02\nMaxArraySize            = 8\n\
                       MaxJobCount             = 10000\n";
         assert_eq!(config_value(config, "MaxArraySize"), Some("8"));
@@ -291,9 +304,11 @@ mod tests {
         ] {
             assert_eq!(parse_time(time), Some(seconds), "{time}");
         }
-        for unlimited in ["UNLIMITED", "INFINITE", "0"] {
+        for unlimited in ["UNLIMITED", "INFINITE", "Unlimited", "-1"] {
             assert_eq!(parse_time(unlimited), Some(None), "{unlimited}");
         }
+        assert_eq!(parse_time("0"), Some(Some(0)));
+        assert_eq!(parse_time("00:00:00"), Some(Some(0)));
         for bad in ["", "abc", "1h", "-5", "1:2:3:4", "1-2:3:4:5", "1--2", "1.5"] {
             assert_eq!(parse_time(bad), None, "{bad:?}");
         }
@@ -305,6 +320,7 @@ mod tests {
             "PartitionTimeLimit",
             "QOSMaxWallDurationPerJobLimit",
             "AssocMaxCpuPerJobLimit",
+            "QOSMinCpuNotSatisfied",
             "InvalidAccount",
             "BadConstraints",
         ] {

@@ -42,7 +42,8 @@ pub struct SlurmOptions {
     /// `sbatch --cpus-per-task`: the threads of each run (a job's own thread count, as the
     /// work-precision study's, takes precedence).
     pub cpus_per_task: usize,
-    /// The most tasks of an array running at once (`--array=0-N%max`).
+    /// The most tasks of an array running at once (`--array=0-N%max`; per array, when the
+    /// runs take several).
     pub max_tasks: Option<usize>,
     /// The spool directory, on a file system shared with the compute nodes.
     pub spool: PathBuf,
@@ -190,8 +191,13 @@ impl Cluster {
         report: &mut dyn FnMut(usize, Outcome) -> Result<()>,
     ) -> Result<()> {
         let mut counts = Counts::default();
-        // Tasks of earlier invocations still queued, by (job, task index): followed again.
-        let live = if rerun { BTreeMap::new() } else { self.live_claims(runs) };
+        // Tasks of earlier invocations still queued: followed again, or cancelled when the
+        // runs are to be run again (two tasks must never share a run directory).
+        let live = self.live_claims(runs)?;
+        if rerun && !live.is_empty() {
+            let ids: Vec<String> = live.iter().map(|(job, task)| format!("{job}_{task}")).collect();
+            run("scancel", &ids.iter().map(String::as_str).collect::<Vec<_>>()).map_err(slurm_error)?;
+        }
         let mut adopted: BTreeMap<u64, Array> = BTreeMap::new();
         // Arrays to submit: threads → runs.
         let mut groups: BTreeMap<usize, Vec<(usize, &RunSpec)>> = BTreeMap::new();
@@ -208,13 +214,14 @@ impl Cluster {
                 continue;
             }
             if let Some(claim) =
-                self.spool.claimed(spec, threads).filter(|c| live.contains_key(&(c.job, c.task)))
+                self.spool.claimed(spec, threads).filter(|c| !rerun && live.contains(&(c.job, c.task)))
             {
                 let array = adopted.entry(claim.job).or_insert_with(|| Array {
                     id: claim.job,
                     dir: claim.array.clone(),
                     threads,
                     tasks: Vec::new(),
+                    adopted: true,
                 });
                 array.tasks.push(Task { index: claim.task, key, spec, ended: false, since: None });
                 continue;
@@ -238,9 +245,7 @@ impl Cluster {
         }
         for (threads, tasks) in groups {
             for (part, tasks) in tasks.chunks(self.max_array).enumerate() {
-                let array = self.submit(threads, part, tasks.to_vec())?;
-                submitted.0.push(array.id.to_string());
-                arrays.push(array);
+                arrays.push(self.submit(threads, part, tasks.to_vec(), &mut submitted)?);
             }
         }
         loop {
@@ -271,6 +276,13 @@ impl Cluster {
                 submitted.0.clear();
                 return Ok(());
             }
+            // An adopted task that ended is no longer anything to cancel.
+            for array in arrays.iter().filter(|a| a.adopted) {
+                for task in array.tasks.iter().filter(|t| t.ended) {
+                    let id = format!("{}_{}", array.id, task.index);
+                    submitted.0.retain(|s| *s != id);
+                }
+            }
             std::thread::sleep(self.opts.poll);
         }
     }
@@ -284,8 +296,14 @@ impl Cluster {
     }
 
     /// Submits one array of `tasks`, each run on `threads` threads (`part`: its place among
-    /// the arrays of this thread count).
-    fn submit<'a>(&self, threads: usize, part: usize, tasks: Vec<(usize, &'a RunSpec)>) -> Result<Array<'a>> {
+    /// the arrays of this thread count), its id added to `submitted` as soon as it exists.
+    fn submit<'a>(
+        &self,
+        threads: usize,
+        part: usize,
+        tasks: Vec<(usize, &'a RunSpec)>,
+        submitted: &mut Submitted,
+    ) -> Result<Array<'a>> {
         let stamp =
             std::time::SystemTime::now().duration_since(std::time::UNIX_EPOCH).map_or(0, |d| d.as_millis());
         let name = format!("{stamp}-{}-t{threads}-{part}", std::process::id());
@@ -315,6 +333,7 @@ impl Cluster {
         let out = run("sbatch", &args.iter().map(String::as_str).collect::<Vec<_>>()).map_err(slurm_error)?;
         let id = commands::parse_job_id(&out)
             .ok_or_else(|| slurm_error(format!("sbatch printed no job id: `{}`", out.trim())))?;
+        submitted.0.push(id.to_string());
         crate::io::write_atomic(&dir.join("job_id"), format!("{id}\n").as_bytes())?;
         for (k, run_dir) in dirs.iter().enumerate() {
             self.spool.claim(run_dir, id, k, &dir)?;
@@ -324,32 +343,52 @@ impl Cluster {
             .enumerate()
             .map(|(index, (key, spec))| Task { index, key, spec, ended: false, since: None })
             .collect();
-        Ok(Array { id, dir, threads, tasks })
+        Ok(Array { id, dir, threads, tasks, adopted: false })
     }
 
-    /// The array tasks that took `runs` in earlier invocations and are still pending or
-    /// running, by (job, task index) (one `squeue` for all their jobs; none when it fails).
-    fn live_claims(&self, runs: &[(usize, &RunSpec, Option<usize>)]) -> BTreeMap<(u64, usize), TaskState> {
-        let jobs: std::collections::BTreeSet<u64> = runs
+    /// The array tasks (job, task index) that took `runs` in earlier invocations and are
+    /// still pending or running: one `squeue` for all their jobs (three tries, then an
+    /// error: a run whose task cannot be seen must not get a second one). A task counts
+    /// only if it is this user's and runs its claim's batch script (a job id that Slurm
+    /// reused after losing its state is another job).
+    fn live_claims(
+        &self,
+        runs: &[(usize, &RunSpec, Option<usize>)],
+    ) -> Result<std::collections::BTreeSet<(u64, usize)>> {
+        let claims: BTreeMap<(u64, usize), PathBuf> = runs
             .iter()
             .filter_map(|&(_, spec, threads)| {
-                self.spool.claimed(spec, threads.unwrap_or(self.opts.cpus_per_task)).map(|c| c.job)
+                self.spool.claimed(spec, threads.unwrap_or(self.opts.cpus_per_task))
             })
+            .map(|c| ((c.job, c.task), c.array.join("run.sh")))
             .collect();
-        if jobs.is_empty() {
-            return BTreeMap::new();
+        if claims.is_empty() {
+            return Ok(Default::default());
         }
-        let list: Vec<String> = jobs.iter().map(u64::to_string).collect();
-        let Ok(out) =
-            run("squeue", &["-h", "-r", "--states=all", "-j", &list.join(","), "-o", "%F %K %T %r"])
-        else {
-            return BTreeMap::new();
-        };
-        commands::parse_squeue_jobs(&out)
+        let jobs: std::collections::BTreeSet<String> =
+            claims.keys().map(|(job, _)| job.to_string()).collect();
+        let list = jobs.into_iter().collect::<Vec<_>>().join(",");
+        let args = ["-h", "-r", "--me", "--states=all", "-j", &list, "-o", "%F %K %T %o"];
+        let mut out = run("squeue", &args);
+        for _ in 0..2 {
+            if out.is_ok() {
+                break;
+            }
+            std::thread::sleep(Duration::from_secs(1));
+            out = run("squeue", &args);
+        }
+        let out = out.map_err(|e| {
+            slurm_error(format!(
+                "{e}: the tasks of earlier invocations cannot be checked, so none is submitted"
+            ))
+        })?;
+        Ok(commands::parse_squeue_jobs(&out)
             .into_iter()
-            .filter(|(_, s)| !s.ended())
-            .map(|(job, s)| ((job, s.task), s))
-            .collect()
+            .filter(|(job, s, script)| {
+                !s.ended() && claims.get(&(*job, s.task)).is_some_and(|c| Path::new(script) == c)
+            })
+            .map(|(job, s, _)| (job, s.task))
+            .collect())
     }
 }
 
@@ -360,6 +399,9 @@ struct Array<'a> {
     dir: PathBuf,
     threads: usize,
     tasks: Vec<Task<'a>>,
+    /// Submitted by an earlier invocation: its tasks are cancelled one by one, and only
+    /// while they run (see [`Submitted`]).
+    adopted: bool,
 }
 
 /// The Slurm ids (`<job>` or `<job>_<task>`) followed by one [`Cluster::run`], cancelled
@@ -572,6 +614,8 @@ fn check_time_limit(time: &str, partition: &str, line: &str) -> Result<()> {
              hours:minutes:seconds, days-hours, days-hours:minutes or days-hours:minutes:seconds)"
         ))
     })?;
+    // `--time=0` asks for no limit.
+    let asked = asked.filter(|&s| s > 0);
     let max_time = commands::field(line, "MaxTime").unwrap_or("UNLIMITED");
     if let Some(Some(max)) = commands::parse_time(max_time)
         && asked.is_none_or(|asked| asked > max)
