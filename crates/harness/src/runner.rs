@@ -48,7 +48,8 @@ pub struct Job {
     /// May take every thread of the machine (running alone, first) when that ends the batch
     /// sooner: for the costliest such job of cost `c` among the batch's uncached jobs of
     /// summed cost `T`, on `W` workers, when `c (1 − 1/s) > (T − c) / W` with `s` the
-    /// speed-up of every thread ([`wide_speedup`]); with two threads, when it is over 60 %
+    /// speed-up of every thread (each past the first adds half a core: 1.5 measured on two,
+    /// docs/notes/main-job-time.md); with two threads, when it is over 60 %
     /// of `T`. Otherwise it runs on a worker's share, like any job with `threads` `None`.
     pub wide: bool,
     /// Estimated cost (any unit shared by the batch, e.g. core-seconds): the costliest jobs
