@@ -107,14 +107,7 @@ fn a_killed_task_is_reported_and_resubmitted_alone() {
         std::thread::spawn(move || validate(&opts).expect("sweep on slurm"))
     };
     // The long run's directory is the one whose scene ends at 0.04 s; kill its task once it runs.
-    let start = Instant::now();
-    let job = loop {
-        assert!(start.elapsed() < Duration::from_secs(120), "the long run never started");
-        if let Some(task) = running_long_task(&spool) {
-            break task;
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let job = long_task_once_running(&spool);
     let status = std::process::Command::new("scancel").arg(&job).status().expect("scancel runs");
     assert!(status.success(), "scancel {job}");
     let first = sweep.join().expect("the sweep thread");
@@ -135,6 +128,18 @@ fn a_killed_task_is_reported_and_resubmitted_alone() {
     );
     assert!(second.results[0].runs.iter().all(|r| !r.status.starts_with("failed")));
     assert!(record.exists());
+}
+
+/// `<job>_<task>` of the long run's task, waiting (two minutes at most) until it runs.
+fn long_task_once_running(spool: &Path) -> String {
+    let start = Instant::now();
+    loop {
+        assert!(start.elapsed() < Duration::from_secs(120), "the long run never started");
+        if let Some(task) = running_long_task(spool) {
+            return task;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
 }
 
 /// `<job>_<task>` of the long run's task once its run started (its `out.partial/` exists).
@@ -240,14 +245,7 @@ fn a_killed_submitters_tasks_are_followed_not_submitted_again() {
         .stdout(std::process::Stdio::null())
         .spawn()
         .expect("the submitter starts");
-    let start = Instant::now();
-    let long = loop {
-        assert!(start.elapsed() < Duration::from_secs(120), "the long run never started");
-        if let Some(task) = running_long_task(&spool) {
-            break task;
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let long = long_task_once_running(&spool);
     submitter.kill().expect("SIGKILL the submitter");
     let _ = submitter.wait();
     let arrays = || std::fs::read_dir(spool.join("arrays")).expect("the spool's arrays").count();
